@@ -1,0 +1,74 @@
+#pragma once
+// The one way karst runs loops in parallel (oneTBB). Kernels are lambdas over an index range, and
+// every reduction is formed so that its result does not depend on the number of threads
+// (style.md P5): each index writes only its own outputs, and sums go over fixed blocks in order.
+#include "karst/core/types.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace karst {
+
+/// Grain of the parallel loops: large enough to hide scheduling cost for SPH-sized work.
+inline constexpr Index k_parallel_grain = 256;
+
+/// Calls body(i) for i in [0, n), in parallel. body must write only data owned by index i.
+template <class Body>
+void parallel_for(Index n, const Body& body) {
+    tbb::parallel_for(tbb::blocked_range<Index>(0, n, k_parallel_grain),
+                      [&](const tbb::blocked_range<Index>& r) {
+                          for (Index i = r.begin(); i != r.end(); ++i) body(i);
+                      });
+}
+
+/// Maximum of f(i) over [0, n) (order-independent, so deterministic), `init` when n == 0.
+template <class F>
+Real parallel_max(Index n, Real init, const F& f) {
+    constexpr Index block = 4096;
+    const Index blocks = (n + block - 1) / block;
+    std::vector<Real> partial(static_cast<size_t>(blocks), init);
+    parallel_for(blocks, [&](Index b) {
+        Real m = init;
+        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) m = std::max(m, f(i));
+        partial[b] = m;
+    });
+    Real m = init;
+    for (Real p : partial) m = std::max(m, p);
+    return m;
+}
+
+/// Sum of f(i) over [0, n) in fixed blocks added in block order: the same bits on any thread count.
+template <class T, class F>
+T deterministic_sum(Index n, T zero, const F& f) {
+    constexpr Index block = 4096;
+    const Index blocks = (n + block - 1) / block;
+    std::vector<T> partial(static_cast<size_t>(blocks), zero);
+    parallel_for(blocks, [&](Index b) {
+        T s = zero;
+        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) s += f(i);
+        partial[b] = s;
+    });
+    T s = zero;
+    for (const T& p : partial) s += p;
+    return s;
+}
+
+/// Limits the threads karst uses for as long as it lives (0 = all cores).
+class ThreadLimit {
+public:
+    explicit ThreadLimit(int threads);
+    ~ThreadLimit();
+    ThreadLimit(const ThreadLimit&) = delete;
+    ThreadLimit& operator=(const ThreadLimit&) = delete;
+    /// Threads actually available to karst's loops.
+    static int active_threads();
+
+private:
+    struct Impl;
+    Impl* m_impl;
+};
+
+}  // namespace karst

@@ -1,0 +1,12 @@
+#pragma once
+// Every output file is written to a temporary name beside its target and renamed over it, so a
+// reader (or a crash) never sees a half-written file (style.md P8).
+#include <filesystem>
+#include <string_view>
+
+namespace karst {
+
+/// Writes `bytes` to `path` atomically; throws std::runtime_error naming the path on failure.
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace karst

@@ -1,0 +1,65 @@
+#include "karst/io/frame_writer.hpp"
+
+#include "karst/io/atomic_file.hpp"
+#include "karst/io/ply_writer.hpp"
+#include "karst/io/vtk_writer.hpp"
+
+#include <fmt/format.h>
+
+#include <regex>
+
+namespace karst {
+
+namespace fs = std::filesystem;
+
+FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings)
+    : m_dir(std::move(dir)), m_settings(settings) {
+    fs::create_directories(m_dir);
+    // Frames of an earlier, longer run would otherwise sit beside this run's.
+    static const std::regex ours(R"((fluid_\d+\.(vtp|ply)|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
+    for (const auto& entry : fs::directory_iterator(m_dir))
+        if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours))
+            fs::remove(entry.path());
+}
+
+void FrameWriter::write_boundary(const WallParticles& walls) {
+    if (!m_settings.vtp || walls.size() == 0) return;
+    PointSet points{walls.x, {}};
+    points.add_scalar("psi", walls.psi);
+    write_file_atomically(m_dir / "boundary.vtp", vtp_bytes(points));
+    m_has_boundary = true;
+}
+
+void FrameWriter::write_frame(const FluidParticles& fluid, const FrameLog& log) {
+    const int frame = frames();
+    PointSet points{fluid.x, {}};
+    points.add_vector("velocity", fluid.v);
+    points.add_scalar("density", fluid.rho);
+    points.add_scalar("pressure", fluid.p);
+    points.add_integer("id", fluid.id);
+    if (m_settings.vtp) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame), vtp_bytes(points));
+    if (m_settings.ply) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
+    m_log.push_back(log);
+
+    if (m_settings.vtp) {
+        std::vector<PvdEntry> entries;
+        for (int f = 0; f < frames(); ++f) {
+            entries.push_back({m_log[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
+            if (m_has_boundary) entries.push_back({m_log[f].time, 1, "boundary.vtp"});
+        }
+        write_file_atomically(m_dir / "run.pvd", pvd_bytes(entries));
+    }
+    std::string csv = "frame,time,dt,steps,particles,density_error,mipps\n";
+    for (int f = 0; f < frames(); ++f) {
+        const FrameLog& r = m_log[f];
+        csv += fmt::format("{},{:.9g},{:.6g},{},{},{:.6g},{:.6g}\n", f, r.time, r.dt, r.steps, r.particles,
+                           r.density_error, r.mipps);
+    }
+    write_file_atomically(m_dir / "log.csv", csv);
+}
+
+void FrameWriter::write_stats(const nlohmann::json& stats) const {
+    write_file_atomically(m_dir / "stats.json", stats.dump(2) + "\n");
+}
+
+}  // namespace karst

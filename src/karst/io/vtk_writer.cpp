@@ -1,0 +1,92 @@
+#include "karst/io/vtk_writer.hpp"
+
+#include <fmt/format.h>
+
+#include <cstring>
+
+namespace karst {
+
+void PointSet::add_scalar(std::string name, const std::vector<Real>& v) {
+    arrays.push_back({std::move(name), 1, false, std::vector<double>(v.begin(), v.end())});
+}
+void PointSet::add_vector(std::string name, const std::vector<Vec3>& v) {
+    PointArray a{std::move(name), 3, false, {}};
+    a.values.reserve(3 * v.size());
+    for (const Vec3& e : v) a.values.insert(a.values.end(), {e[0], e[1], e[2]});
+    arrays.push_back(std::move(a));
+}
+void PointSet::add_integer(std::string name, const std::vector<std::int64_t>& v) {
+    arrays.push_back({std::move(name), 1, true, std::vector<double>(v.begin(), v.end())});
+}
+
+namespace {
+
+/// Appended-data block: UInt64 byte count, then the values.
+template <class T>
+void append_block(std::string& blob, const std::vector<T>& values) {
+    const std::uint64_t bytes = values.size() * sizeof(T);
+    blob.append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+    blob.append(reinterpret_cast<const char*>(values.data()), bytes);
+}
+
+std::vector<float> to_float(const std::vector<double>& v) { return {v.begin(), v.end()}; }
+
+}  // namespace
+
+std::string vtp_bytes(const PointSet& points) {
+    const size_t n = points.x.size();
+    std::string blob, point_data;
+    for (const PointArray& a : points.arrays) {
+        point_data += fmt::format(
+            "        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
+            a.integer ? "Int64" : "Float32", a.name, a.components, blob.size());
+        if (a.integer)
+            append_block(blob, std::vector<std::int64_t>(a.values.begin(), a.values.end()));
+        else
+            append_block(blob, to_float(a.values));
+    }
+    const size_t points_offset = blob.size();
+    std::vector<float> xyz;
+    xyz.reserve(3 * n);
+    for (const Vec3& x : points.x) xyz.insert(xyz.end(), {float(x[0]), float(x[1]), float(x[2])});
+    append_block(blob, xyz);
+    const size_t conn_offset = blob.size();
+    std::vector<std::int64_t> conn(n), offsets(n);
+    for (size_t i = 0; i < n; ++i) conn[i] = std::int64_t(i), offsets[i] = std::int64_t(i + 1);
+    append_block(blob, conn);
+    const size_t offsets_offset = blob.size();
+    append_block(blob, offsets);
+
+    std::string out = fmt::format(
+        "<?xml version=\"1.0\"?>\n"
+        "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+        "  <PolyData>\n"
+        "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+        "      <PointData>\n{1}      </PointData>\n"
+        "      <Points>\n"
+        "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{2}\"/>\n"
+        "      </Points>\n"
+        "      <Verts>\n"
+        "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{3}\"/>\n"
+        "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{4}\"/>\n"
+        "      </Verts>\n"
+        "    </Piece>\n"
+        "  </PolyData>\n"
+        "  <AppendedData encoding=\"raw\">\n   _",
+        n, point_data, points_offset, conn_offset, offsets_offset);
+    out += blob;
+    out += "\n  </AppendedData>\n</VTKFile>\n";
+    return out;
+}
+
+std::string pvd_bytes(const std::vector<PvdEntry>& entries) {
+    std::string out =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+        "  <Collection>\n";
+    for (const PvdEntry& e : entries)
+        out += fmt::format("    <DataSet timestep=\"{:.17g}\" part=\"{}\" file=\"{}\"/>\n", e.time, e.part, e.file);
+    out += "  </Collection>\n</VTKFile>\n";
+    return out;
+}
+
+}  // namespace karst

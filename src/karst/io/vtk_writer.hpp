@@ -1,0 +1,22 @@
+#pragma once
+#include "karst/io/point_arrays.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace karst {
+
+/// VTK XML PolyData (.vtp), appended raw binary, with a Verts cell per point so ParaView draws
+/// the points. Positions and float arrays are Float32, integer arrays Int64.
+std::string vtp_bytes(const PointSet& points);
+
+/// One data set of a ParaView collection (.pvd).
+struct PvdEntry {
+    double time;
+    int part;
+    std::string file;
+};
+std::string pvd_bytes(const std::vector<PvdEntry>& entries);
+
+}  // namespace karst

@@ -1,0 +1,107 @@
+#include "karst/scene/scene.hpp"
+#include "karst/scene/scene_error.hpp"
+#include "karst/scene/validate.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <sstream>
+
+namespace karst {
+
+namespace {
+
+using json = nlohmann::json;
+
+Vec3 vec3(const json& v) { return {v[0].get<Real>(), v[1].get<Real>(), v[2].get<Real>()}; }
+
+Shape read_shape(const json& j, const std::string& path) {
+    Shape s;
+    const std::string type = j["type"];
+    if (type == "box") {
+        s.kind = Shape::Kind::Box, s.a = vec3(j["min"]), s.b = vec3(j["max"]);
+        for (int d = 0; d < 3; ++d)
+            if (!(s.b[d] > s.a[d]))
+                throw SceneError(path + "/max", fmt::format("max[{}] > min[{}] = {}", d, d, s.a[d]),
+                                 fmt::format("{}", s.b[d]));
+    } else if (type == "sphere") {
+        s.kind = Shape::Kind::Sphere, s.a = vec3(j["center"]), s.radius = j["radius"];
+    } else if (type == "cylinder") {
+        s.kind = Shape::Kind::Cylinder, s.a = vec3(j["base"]), s.b = vec3(j["top"]), s.radius = j["radius"];
+        if ((s.b - s.a).norm() <= 0)
+            throw SceneError(path + "/top", "a point different from base", j["top"].dump());
+    } else {
+        s.kind = type == "union" ? Shape::Kind::Union : Shape::Kind::Difference;
+        for (size_t i = 0; i < j["shapes"].size(); ++i)
+            s.children.push_back(read_shape(j["shapes"][i], fmt::format("{}/shapes/{}", path, i)));
+    }
+    return s;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text) {
+    json doc;
+    try {
+        doc = json::parse(text);
+    } catch (const json::parse_error& e) {
+        throw SceneError("", "valid JSON", fmt::format("a syntax error at byte {}: {}", e.byte, e.what()));
+    }
+    validate_scene_document(doc);
+
+    Scene s;
+    s.name = doc["name"];
+    s.particle_spacing = doc["particle_spacing"];
+    s.gravity = vec3(doc["gravity"]);
+    if (doc.contains("domain")) {
+        s.domain = Aabb{vec3(doc["domain"]["min"]), vec3(doc["domain"]["max"])};
+        for (int d = 0; d < 3; ++d)
+            if (!(s.domain->max[d] > s.domain->min[d]))
+                throw SceneError(fmt::format("/domain/max/{}", d), fmt::format("a value above min {}", s.domain->min[d]),
+                                 fmt::format("{}", s.domain->max[d]));
+    }
+    const json& t = doc["time"];
+    s.time.end = t["end"], s.time.cfl = t["cfl"], s.time.dt_max = t["dt_max"], s.time.dt_min = t["dt_min"];
+    if (t.contains("fixed_dt")) s.time.fixed_dt = t["fixed_dt"].get<Real>();
+    if (s.time.dt_min > s.time.dt_max)
+        throw SceneError("/time/dt_min", fmt::format("a value at most dt_max = {}", s.time.dt_max),
+                         fmt::format("{}", s.time.dt_min));
+
+    const json& f = doc["fluid"];
+    s.fluid.rest_density = f["rest_density"], s.fluid.viscosity = f["viscosity"];
+    s.fluid.surface_tension = f["surface_tension"], s.fluid.adhesion = f["adhesion"];
+    s.fluid.wall_friction = f["wall_friction"], s.fluid.sound_speed = f["sound_speed"];
+    s.fluid.max_density_error = f["max_density_error"];
+    s.fluid.min_iterations = f["min_iterations"], s.fluid.max_iterations = f["max_iterations"];
+    if (s.fluid.min_iterations > s.fluid.max_iterations)
+        throw SceneError("/fluid/min_iterations", fmt::format("at most max_iterations = {}", s.fluid.max_iterations),
+                         fmt::format("{}", s.fluid.min_iterations));
+
+    for (size_t i = 0; i < doc["fluid_blocks"].size(); ++i) {
+        const json& b = doc["fluid_blocks"][i];
+        const std::string path = fmt::format("/fluid_blocks/{}", i);
+        s.fluid_blocks.push_back({read_shape(b["shape"], path + "/shape"), vec3(b["velocity"]), path});
+    }
+    for (size_t i = 0; i < doc["walls"].size(); ++i) {
+        const json& w = doc["walls"][i];
+        const std::string path = fmt::format("/walls/{}", i);
+        s.walls.push_back({read_shape(w["shape"], path + "/shape"),
+                           w["kind"] == "container" ? Wall::Kind::Container : Wall::Kind::Obstacle,
+                           w["layers"].get<int>(), path});
+    }
+    s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"], s.output.ply = doc["output"]["ply"];
+    s.max_speed = doc["watchdog"]["max_speed"];
+    s.sort_interval = doc["numerics"]["sort_interval"];
+    return s;
+}
+
+Scene load_scene_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw SceneError("", "a readable scene file", fmt::format("no file at '{}'", path));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_scene(ss.str());
+}
+
+}  // namespace karst

@@ -1,0 +1,74 @@
+#pragma once
+// The scene as plain typed data, read from a validated JSON document (every key present or
+// defaulted by the schema). Model building (sim/model.cpp) turns it into particles.
+#include "karst/core/types.hpp"
+#include "karst/scene/geometry.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace karst {
+
+struct TimeSettings {
+    Real end = 2.0;                ///< s
+    Real cfl = 0.4;                ///< lambda_v of M11
+    Real dt_max = 5e-3;            ///< s
+    Real dt_min = 1e-7;            ///< s
+    std::optional<Real> fixed_dt;  ///< s; absent: adaptive
+};
+
+struct FluidSettings {
+    Real rest_density = 1000;       ///< rho0, kg/m^3
+    Real viscosity = 1e-6;          ///< nu, m^2/s
+    Real surface_tension = 0;       ///< gamma_st
+    Real adhesion = 0;              ///< beta_adh
+    Real wall_friction = 0;         ///< sigma_f
+    Real sound_speed = 20;          ///< c_s, m/s
+    Real max_density_error = 0.01;  ///< eta_rho
+    int min_iterations = 3;
+    int max_iterations = 50;
+};
+
+struct FluidBlock {
+    Shape shape;
+    Vec3 velocity = Vec3::Zero();  ///< m/s
+    std::string path;              ///< JSON pointer, for error messages
+};
+
+struct Wall {
+    enum class Kind { Obstacle, Container };
+    Shape shape;
+    Kind kind = Kind::Obstacle;
+    int layers = 1;
+    std::string path;
+};
+
+struct OutputSettings {
+    Real fps = 30;
+    bool vtp = true;
+    bool ply = true;
+};
+
+struct Scene {
+    std::string name;
+    Real particle_spacing = 0.02;  ///< dx, m
+    Vec3 gravity{0, 0, -9.81};     ///< m/s^2
+    std::optional<Aabb> domain;
+    TimeSettings time;
+    FluidSettings fluid;
+    std::vector<FluidBlock> fluid_blocks;
+    std::vector<Wall> walls;
+    OutputSettings output;
+    Real max_speed = 100;  ///< watchdog, m/s
+    int sort_interval = 10;
+};
+
+/// Parses and validates scene text; throws SceneError (path, expected, found) on any problem.
+Scene parse_scene(const std::string& text);
+/// Reads a scene file; a missing or unreadable file is a SceneError too.
+Scene load_scene_file(const std::string& path);
+/// The built-in default scene (scenes/dam_break_obstacle.json, compiled in).
+const std::string& default_scene_text();
+
+}  // namespace karst

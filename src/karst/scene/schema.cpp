@@ -1,0 +1,189 @@
+#include "karst/scene/schema.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace karst {
+
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+using json = nlohmann::json;
+
+Range positive(double hi = inf) { return {0.0, hi, true, false}; }
+Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+Range any() { return {}; }
+
+KeySpec key(std::string pointer, ValueType type, std::string unit, Range range,
+            std::optional<json> value, std::string doc, std::vector<std::string> options = {}) {
+    return KeySpec{std::move(pointer), type,  std::move(unit), range,
+                   std::move(value),   false, std::move(doc),  std::move(options)};
+}
+KeySpec required(std::string pointer, ValueType type, std::string unit, Range range,
+                 std::string doc, std::vector<std::string> options = {}) {
+    return KeySpec{std::move(pointer), type, std::move(unit), range, std::nullopt,
+                   true, std::move(doc), std::move(options)};
+}
+KeySpec optional(std::string pointer, ValueType type, std::string unit, Range range,
+                 std::string doc) {
+    return KeySpec{std::move(pointer), type, std::move(unit), range, std::nullopt, false,
+                   std::move(doc), {}};
+}
+
+std::vector<KeySpec> make_schema() {
+    using T = ValueType;
+    const json zero3 = json::array({0.0, 0.0, 0.0});
+    return {
+        required("/name", T::String, "", any(), "Scene name; output goes to out/<name>/ by default."),
+        required("/particle_spacing", T::Number, "m", positive(10.0),
+                 "Particle spacing dx. The SPH support radius is h = 2 dx (method.md §1)."),
+        key("/gravity", T::Vec3, "m/s^2", closed(-1000, 1000), json::array({0.0, 0.0, -9.81}),
+            "Gravitational acceleration; z is up."),
+        optional("/domain", T::Object, "",  any(),
+                 "Simulation box; particles leaving it are removed and counted. Absent: the bounds "
+                 "of all geometry padded by 4 h on every side."),
+        required("/domain/min", T::Vec3, "m", any(), "Lower corner of the domain."),
+        required("/domain/max", T::Vec3, "m", any(), "Upper corner of the domain."),
+
+        key("/time", T::Object, "", any(), json::object(), "Time integration."),
+        key("/time/end", T::Number, "s", closed(0, 1e6), 2.0, "Simulated end time."),
+        key("/time/cfl", T::Number, "", closed(0.01, 1.0), 0.4,
+            "CFL number lambda_v: dt <= lambda_v dx / v_max (M11)."),
+        key("/time/dt_max", T::Number, "s", positive(1.0), 5e-3, "Upper clamp of the time step."),
+        key("/time/dt_min", T::Number, "s", positive(1.0), 1e-7,
+            "Lower clamp of the time step; a run needing less is unstable and stops."),
+        optional("/time/fixed_dt", T::Number, "s", positive(1.0),
+                 "Fixed time step; absent: adaptive CFL step (M11)."),
+
+        key("/fluid", T::Object, "", any(), json::object(), "Fluid (PCISPH) material and solver."),
+        key("/fluid/rest_density", T::Number, "kg/m^3", closed(100, 20000), 1000.0,
+            "Rest density rho0."),
+        key("/fluid/viscosity", T::Number, "m^2/s", closed(0, 1.0), 1e-6,
+            "Kinematic viscosity nu (method.md §4.2)."),
+        key("/fluid/surface_tension", T::Number, "", closed(0, 100), 0.0,
+            "Akinci 2013 surface-tension coefficient gamma_st (M9); 0 disables it."),
+        key("/fluid/adhesion", T::Number, "", closed(0, 100), 0.0,
+            "Akinci 2013 adhesion coefficient beta_adh to walls (M10); 0 disables it."),
+        key("/fluid/wall_friction", T::Number, "", closed(0, 10), 0.0,
+            "Akinci 2012 fluid-wall friction coefficient sigma_f; 0 gives free slip."),
+        key("/fluid/sound_speed", T::Number, "m/s", positive(1e4), 20.0,
+            "Numerical sound speed c_s used by wall friction (about 10x the expected speed)."),
+        key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
+            "PCISPH stops when the maximum clamped density error is below this fraction of rho0."),
+        key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
+            "PCISPH minimum predictor-corrector iterations."),
+        key("/fluid/max_iterations", T::Integer, "", closed(1, 1000), 50,
+            "PCISPH maximum predictor-corrector iterations."),
+
+        key("/fluid_blocks", T::ObjectArray, "", any(), json::array(),
+            "Blocks of fluid sampled on the scene lattice (i + 1/2) dx."),
+        required("/fluid_blocks/[]/shape", T::Shape, "", any(), "Geometry of the block."),
+        key("/fluid_blocks/[]/velocity", T::Vec3, "m/s", closed(-1000, 1000), zero3,
+            "Initial velocity."),
+
+        key("/walls", T::ObjectArray, "", any(), json::array(),
+            "Static walls sampled as Akinci 2012 boundary particles."),
+        required("/walls/[]/shape", T::Shape, "", any(), "Geometry of the wall."),
+        key("/walls/[]/kind", T::Enum, "", any(), "obstacle",
+            "obstacle: particles fill a skin inside the shape; container: the shape is the cavity "
+            "and particles fill a skin around it.",
+            {"obstacle", "container"}),
+        key("/walls/[]/layers", T::Integer, "", closed(1, 4), 1,
+            "Thickness of the particle skin, in particle layers."),
+
+        key("/output", T::Object, "", any(), json::object(), "What is written, and how often."),
+        key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0, "Frames per simulated second."),
+        key("/output/vtp", T::Bool, "", any(), true, "Write fluid_NNNN.vtp frames and run.pvd."),
+        key("/output/ply", T::Bool, "", any(), true, "Write binary PLY point frames fluid_NNNN.ply."),
+
+        key("/watchdog", T::Object, "", any(), json::object(), "Run-time sanity limits."),
+        key("/watchdog/max_speed", T::Number, "m/s", positive(1e6), 100.0,
+            "A particle faster than this stops the run (exit code 1)."),
+
+        key("/numerics", T::Object, "", any(), json::object(), "Performance knobs."),
+        key("/numerics/sort_interval", T::Integer, "", closed(1, 100000), 10,
+            "Steps between reorderings of the particle arrays along a Morton curve."),
+
+        required("shape/type", T::Enum, "", any(), "Kind of geometry.",
+                 {"box", "sphere", "cylinder", "union", "difference"}),
+        required("shape:box/min", T::Vec3, "m", any(), "Box lower corner."),
+        required("shape:box/max", T::Vec3, "m", any(), "Box upper corner."),
+        required("shape:sphere/center", T::Vec3, "m", any(), "Sphere centre."),
+        required("shape:sphere/radius", T::Number, "m", positive(), "Sphere radius."),
+        required("shape:cylinder/base", T::Vec3, "m", any(), "Centre of the base disk."),
+        required("shape:cylinder/top", T::Vec3, "m", any(), "Centre of the top disk."),
+        required("shape:cylinder/radius", T::Number, "m", positive(), "Cylinder radius."),
+        required("shape:union/shapes", T::ShapeArray, "", any(), "Shapes joined together."),
+        required("shape:difference/shapes", T::ShapeArray, "", any(),
+                 "The first shape minus all the others."),
+    };
+}
+
+std::string format_number(double v) {
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+    return fmt::format("{:g}", v);
+}
+
+}  // namespace
+
+bool Range::contains(double v) const {
+    if (std::isnan(v)) return false;
+    if (lo_open ? !(v > lo) : !(v >= lo)) return false;
+    if (hi_open ? !(v < hi) : !(v <= hi)) return false;
+    return true;
+}
+
+std::string Range::describe() const {
+    if (std::isinf(lo) && std::isinf(hi)) return "";
+    return fmt::format("{}{}, {}{}", lo_open ? "(" : "[", format_number(lo), format_number(hi),
+                       hi_open ? ")" : "]");
+}
+
+const std::vector<KeySpec>& scene_schema() {
+    static const std::vector<KeySpec> schema = make_schema();
+    return schema;
+}
+
+std::string describe_type(const KeySpec& spec) {
+    switch (spec.type) {
+        case ValueType::String: return "string";
+        case ValueType::Number: return "number";
+        case ValueType::Integer: return "integer";
+        case ValueType::Bool: return "boolean";
+        case ValueType::Vec3: return "array of 3 numbers";
+        case ValueType::Enum: {
+            std::string s = "one of";
+            for (size_t i = 0; i < spec.options.size(); ++i)
+                s += fmt::format("{} \"{}\"", i ? "," : "", spec.options[i]);
+            return s;
+        }
+        case ValueType::Object: return "object";
+        case ValueType::ObjectArray: return "array of objects";
+        case ValueType::Shape: return "shape object";
+        case ValueType::ShapeArray: return "non-empty array of shape objects";
+    }
+    return "?";
+}
+
+std::string scene_schema_markdown() {
+    std::string md =
+        "# Scene format\n\n"
+        "<!-- Generated by `karst schema` from src/karst/scene/schema.cpp; do not edit. -->\n\n"
+        "A scene is one JSON object. Units are SI. Unknown keys, wrong types and out-of-range values\n"
+        "are refused before simulating, with the JSON path, what was expected and what was found\n"
+        "(exit code 2). `[]` stands for any array index. Geometry objects (`shape`) are described by\n"
+        "the `shape` rows: `shape/type` picks the kind and `shape:<type>/...` lists its keys;\n"
+        "`union` and `difference` nest further shapes. All particles lie on one lattice\n"
+        "`(i + 1/2) dx`, so fluid and walls fit together without gaps.\n\n"
+        "| key | type | unit | range | default | description |\n"
+        "|---|---|---|---|---|---|\n";
+    for (const KeySpec& s : scene_schema()) {
+        std::string def = s.value ? s.value->dump() : (s.required ? "required" : "optional");
+        md += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", s.pointer, describe_type(s), s.unit,
+                          s.range.describe(), def, s.doc);
+    }
+    return md;
+}
+
+}  // namespace karst

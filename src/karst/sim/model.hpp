@@ -1,0 +1,51 @@
+#pragma once
+// The immutable model (style.md P3): everything the scene fixes for the whole run, including the
+// static wall particles, their Akinci volumes and their cell-sorted layout. Built once from a
+// Scene; all geometry checks that refuse a scene happen here, before simulating.
+#include "karst/core/types.hpp"
+#include "karst/scene/scene.hpp"
+#include "karst/sph/kernels.hpp"
+#include "karst/sph/neighbour_grid.hpp"
+
+#include <vector>
+
+namespace karst {
+
+/// Static boundary particles (Akinci 2012), stored in cell order of `grid`.
+struct WallParticles {
+    std::vector<Vec3> x;    ///< (n), m
+    std::vector<Real> psi;  ///< (n), Psi_k = rho0 V_b,k, kg/m^3 * m^3 = kg
+    CellRanges cells;       ///< particle ranges per grid cell
+    Index size() const { return Index(x.size()); }
+};
+
+struct Model {
+    Scene scene;
+    Real dx = 0;                ///< particle spacing, m
+    Real h = 0;                 ///< support radius 2 dx, m
+    Real rho0 = 1000;           ///< kg/m^3
+    Real particle_mass = 0;     ///< m_f0 = rho0 dx^3, kg
+    CubicKernel kernel{1.0};
+    /// |sum grad W|^2 + sum |grad W|^2 on a full lattice neighbourhood (1/m^8): the prototype
+    /// particle of M8, fixed by the lattice, so delta(dt) is closed-form.
+    Real pcisph_prototype_sum = 0;
+    Aabb domain;
+    UniformGrid grid;
+    WallParticles walls;
+    std::vector<Vec3> initial_x;  ///< fluid particles at t = 0, m
+    std::vector<Vec3> initial_v;  ///< m/s
+
+    /// M8: delta = rho0^2 / (2 dt^2 m^2 (|sum grad W|^2 + sum |grad W|^2)), in Pa per kg/m^3.
+    Real pcisph_delta(Real dt) const {
+        return rho0 * rho0 / (2 * dt * dt * particle_mass * particle_mass * pcisph_prototype_sum);
+    }
+};
+
+/// Most particles a scene may have (fluid + walls).
+inline constexpr double k_max_particles = 50e6;
+
+/// Samples the scene and checks its geometry; throws SceneError for empty or overlapping
+/// geometry, a domain not holding the particles, or more than k_max_particles particles.
+Model build_model(const Scene& scene);
+
+}  // namespace karst

@@ -1,0 +1,31 @@
+#pragma once
+// The one-line progress display on stderr: rewritten in place on a terminal, printed as plain
+// periodic lines otherwise (logs, CI).
+#include "karst/core/timer.hpp"
+
+namespace karst {
+
+struct ProgressInfo {
+    int frame = 0;
+    double time = 0, end_time = 0;   ///< simulated, s
+    double steps_per_second = 0;
+    double mipps = 0;                ///< million particle-steps per second
+    double eta_seconds = 0;          ///< wall-clock seconds left
+    long long particles = 0;
+};
+
+class ProgressLine {
+public:
+    explicit ProgressLine(bool quiet);
+    /// Shows `info` if enough wall time has passed since the last line (or `force`).
+    void update(const ProgressInfo& info, bool force = false);
+    /// Ends the line on a terminal.
+    void finish();
+
+private:
+    bool m_quiet, m_tty, m_dirty = false;
+    Stopwatch m_since_print;
+    bool m_printed = false;
+};
+
+}  // namespace karst

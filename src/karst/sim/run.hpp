@@ -1,0 +1,33 @@
+#pragma once
+// A whole run: model, state, the time loop with frame cadence, output and the watchdog.
+#include "karst/scene/scene.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace karst {
+
+struct RunOptions {
+    std::optional<std::filesystem::path> out_dir;  ///< default out/<scene name>/
+    std::optional<double> end_time;                ///< s; overrides /time/end
+    std::optional<double> fps;                     ///< overrides /output/fps
+    int threads = 0;                               ///< 0: all cores
+    bool quiet = false;
+};
+
+struct RunResult {
+    bool ok = true;
+    std::string failure;       ///< watchdog message when !ok
+    std::filesystem::path out_dir;
+    nlohmann::json stats;      ///< what stats.json holds
+};
+
+/// Runs `scene` to its end time, writing frames. Throws SceneError before writing anything if
+/// the scene or the options are bad; a watchdog stop returns ok = false after writing the last
+/// good frame and stats.json.
+RunResult run_simulation(const Scene& scene, const RunOptions& options);
+
+}  // namespace karst

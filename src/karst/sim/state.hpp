@@ -1,0 +1,55 @@
+#pragma once
+// The mutable state (style.md P3/P4): fluid particles as one array per attribute, the time, and
+// per-step derived data (neighbour lists, accelerations) kept apart from the physical state.
+#include "karst/core/types.hpp"
+#include "karst/sph/neighbour_grid.hpp"
+
+#include <vector>
+
+namespace karst {
+
+struct Model;
+
+/// The physical state of the fluid: everything needed to restart or write a frame.
+struct FluidParticles {
+    std::vector<Vec3> x;          ///< (n) position, m
+    std::vector<Vec3> v;          ///< (n) velocity, m/s
+    std::vector<Real> mass;       ///< (n) kg
+    std::vector<Real> rho;        ///< (n) density of the last step (M7), kg/m^3
+    std::vector<Real> p;          ///< (n) PCISPH pressure of the last step, Pa
+    std::vector<std::int64_t> id; ///< (n) stable particle id (export only)
+    Index size() const { return Index(x.size()); }
+    /// Keeps the particles whose flag is true, in order.
+    void keep(const std::vector<char>& flag);
+    /// Reorders every attribute by perm (new k <- old perm[k]).
+    void permute(const std::vector<std::uint32_t>& perm);
+};
+
+/// Data rebuilt every step from the physical state.
+struct FluidScratch {
+    CellRanges cells;               ///< fluid particles sorted by cell
+    NeighbourLists fluid_fluid;     ///< fluid neighbours (self excluded)
+    NeighbourLists fluid_wall;      ///< wall neighbours
+    std::vector<Vec3> a_other;      ///< (n) non-pressure acceleration incl. gravity, m/s^2
+    std::vector<Vec3> a_pressure;   ///< (n) pressure acceleration, m/s^2
+    std::vector<Vec3> normal;       ///< (n) Akinci 2013 surface normal, dimensionless
+    std::vector<Vec3> x_pred;       ///< (n) PCISPH predicted position, m
+    std::vector<Real> rho_err;      ///< (n) clamped predicted density error, kg/m^3
+    std::vector<Real> delta;        ///< (n) PCISPH scaling factor delta_i, Pa m^3/kg
+};
+
+struct State {
+    FluidParticles fluid;
+    FluidScratch scratch;
+    Real time = 0;                ///< s
+    Index steps = 0;
+    Real dt = 0;                  ///< last step, s
+    Real a_max = 0;               ///< largest acceleration of the last step, m/s^2
+    Index removed = 0;            ///< particles that left the domain
+    std::int64_t next_id = 0;
+};
+
+/// Fluid at t = 0 from the model's sampled blocks.
+State make_initial_state(const Model& model);
+
+}  // namespace karst

@@ -1,0 +1,18 @@
+#pragma once
+#include "karst/sim/model.hpp"
+#include "karst/sim/state.hpp"
+#include "karst/sim/step_profile.hpp"
+
+namespace karst {
+
+struct StepReport {
+    Real dt = 0;                 ///< s
+    int pressure_iterations = 0;
+    Real max_density_error = 0;  ///< fraction of rho0
+};
+
+/// Advances the state by one step of length dt (method.md §3; this stages 1-5).
+/// Throws WatchdogError if a stage produces a NaN or a runaway speed.
+StepReport step(const Model& model, State& state, Real dt, StepProfile& profile);
+
+}  // namespace karst

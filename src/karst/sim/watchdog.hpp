@@ -1,0 +1,27 @@
+#pragma once
+// The per-stage health check (style.md P8): the first NaN, infinity or runaway speed stops the
+// run, naming the stage, the particle and the time.
+#include "karst/core/types.hpp"
+#include "karst/sim/step_profile.hpp"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace karst {
+
+struct WatchdogError : std::runtime_error {
+    WatchdogError(std::string_view stage, std::int64_t particle_id, Real time, const std::string& what);
+    std::string stage;
+    std::int64_t particle_id;
+    Real time;
+};
+
+/// Throws WatchdogError if any entry of `values` is not finite (or, when max_norm > 0, longer
+/// than max_norm), naming `quantity`, the stage and the particle's id.
+void check_vectors(const std::vector<Vec3>& values, const std::vector<std::int64_t>& id, Stage stage,
+                   Real time, const char* quantity, Real max_norm = 0);
+void check_scalars(const std::vector<Real>& values, const std::vector<std::int64_t>& id, Stage stage,
+                   Real time, const char* quantity);
+
+}  // namespace karst

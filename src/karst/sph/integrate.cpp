@@ -1,0 +1,40 @@
+#include "karst/sph/integrate.hpp"
+
+#include "karst/core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace karst {
+
+Real integrate_fluid(const Model& model, State& state, Real dt) {
+    FluidParticles& f = state.fluid;
+    const FluidScratch& s = state.scratch;
+    const Index n = f.size();
+    std::vector<char> inside(n);
+    parallel_for(n, [&](Index i) {
+        f.v[i] += dt * (s.a_other[i] + s.a_pressure[i]);
+        f.x[i] += dt * f.v[i];
+        inside[i] = model.domain.contains(f.x[i]);
+    });
+    const Real a_max = parallel_max(n, 0.0, [&](Index i) { return (s.a_other[i] + s.a_pressure[i]).norm(); });
+    const Index kept = std::count(inside.begin(), inside.end(), 1);
+    if (kept != n) {
+        state.removed += n - kept;
+        f.keep(inside);
+    }
+    return a_max;
+}
+
+Real cfl_time_step(const Model& model, const State& state) {
+    const TimeSettings& t = model.scene.time;
+    if (t.fixed_dt) return *t.fixed_dt;
+    const FluidParticles& f = state.fluid;
+    const Real v_max = std::sqrt(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }));
+    Real dt = t.dt_max;
+    if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
+    if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));
+    return std::max(dt, t.dt_min);
+}
+
+}  // namespace karst

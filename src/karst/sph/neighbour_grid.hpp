@@ -1,0 +1,70 @@
+#pragma once
+// Neighbour search on a uniform cell grid (cell size h) built by counting sort, with
+// fixed-capacity neighbour lists per particle, and the Morton (Z-curve) order used to reorder
+// particle arrays for locality. Results do not depend on the thread count: a particle's
+// neighbours are listed in cell order, then in array order within a cell.
+#include "karst/core/types.hpp"
+#include "karst/scene/geometry.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace karst {
+
+struct UniformGrid {
+    Vec3 origin = Vec3::Zero();  ///< lower corner of cell (0, 0, 0), m
+    Real cell = 1;               ///< cell edge = support radius h, m
+    std::array<int, 3> dims{1, 1, 1};
+
+    UniformGrid() = default;
+    /// Grid covering `box`; throws SceneError if it would need more than `max_cells` cells.
+    UniformGrid(const Aabb& box, Real cell_size);
+    Index cell_count() const { return Index(dims[0]) * dims[1] * dims[2]; }
+    std::array<int, 3> coords(const Vec3& x) const;
+    Index linear(const std::array<int, 3>& c) const { return c[0] + Index(dims[0]) * (c[1] + Index(dims[1]) * c[2]); }
+    Index cell_of(const Vec3& x) const { return linear(coords(x)); }
+};
+
+/// Particles sorted by cell: the particles of cell c are order[start[c] .. start[c + 1]), and
+/// sorted_x holds their positions in that order (contiguous reads in the neighbour loop).
+struct CellRanges {
+    std::vector<std::uint32_t> start;  ///< (cells + 1)
+    std::vector<std::uint32_t> order;  ///< (n) particle index per sorted slot
+    std::vector<Vec3> sorted_x;        ///< (n) m
+};
+
+/// Counting sort of `x` into the cells of `grid` (stable, so deterministic). Every x must lie
+/// inside the grid.
+void sort_into_cells(const UniformGrid& grid, const std::vector<Vec3>& x, CellRanges& out);
+
+/// Neighbour lists with a fixed capacity per particle: the neighbours of i are
+/// index[i * capacity .. i * capacity + count[i]).
+struct NeighbourLists {
+    int capacity = 48;
+    std::vector<std::uint32_t> index;
+    std::vector<std::uint16_t> count;
+    template <class F>
+    void for_each(Index i, const F& f) const {
+        const std::uint32_t* list = index.data() + i * capacity;
+        for (int k = 0; k < count[i]; ++k) f(Index(list[k]));
+    }
+};
+
+/// For each query point, lists the particles of `targets` closer than grid.cell (strictly).
+/// With `exclude_self`, the query i skips target i (queries and targets are the same set).
+/// The capacity grows (and the search repeats) when a particle has more neighbours.
+void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
+                     const CellRanges& targets, bool exclude_self, NeighbourLists& out);
+
+/// Permutation sorting `x` along the Morton curve of their grid cells (ties by index).
+std::vector<std::uint32_t> morton_order(const UniformGrid& grid, const std::vector<Vec3>& x);
+
+/// Applies a permutation in place: a[k] <- a[perm[k]].
+template <class T>
+void apply_permutation(std::vector<T>& a, const std::vector<std::uint32_t>& perm) {
+    std::vector<T> tmp(a.size());
+    for (size_t k = 0; k < perm.size(); ++k) tmp[k] = a[perm[k]];
+    a.swap(tmp);
+}
+
+}  // namespace karst
