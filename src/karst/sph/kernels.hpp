@@ -68,7 +68,8 @@ inline Real cohesion_kernel(Real r, Real h) {
 /// M10: Akinci 2013 adhesion kernel, A = 0.007/h^3.25 (-4r^2/h + 6r - 2h)^(1/4) on (h/2, h].
 inline Real adhesion_kernel(Real r, Real h) {
     if (r <= 0.5 * h || r > h) return 0;
-    return 0.007 / std::pow(h, 3.25) * std::pow(-4 * r * r / h + 6 * r - 2 * h, 0.25);
+    // The polynomial is zero at r = h; rounding can make it -1e-18 there, and pow would give NaN.
+    return 0.007 / std::pow(h, 3.25) * std::pow(std::max(-4 * r * r / h + 6 * r - 2 * h, Real(0)), 0.25);
 }
 
 }  // namespace karst

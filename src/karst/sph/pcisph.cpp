@@ -7,8 +7,10 @@ namespace karst {
 
 namespace {
 
-/// a_i^p = -sum_j m_j (p_i + p_j) / rho0^2 grad W_ij - sum_k Psi_k p_i / rho0^2 grad W_ik
-/// (Akinci 2012: the wall term uses p_i only), at the current positions; then the prediction
+/// a_i^p = -sum_j m_j (p_i + p_j) / rho0^2 grad W_ij - sum_k Psi_k 2 p_i / rho0^2 grad W_ik at the
+/// current positions. The wall term mirrors the pressure (p_k = p_i, the variant method.md §4.3
+/// names) [D]: with p_i alone a wall-adjacent particle needs twice the hydrostatic pressure to
+/// carry the column above it, and the hydrostatic test fails by 100 % in the first layer. Then the prediction
 /// x*_i = x_i + dt (v_i + dt (a_other + a_p)) for the next density pass.
 void pressure_acceleration_and_prediction(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
@@ -26,7 +28,7 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
         if (pi != 0)
             s.fluid_wall.for_each(i, [&](Index k) {
                 const Vec3 xik = xi - model.walls.x[k];
-                a -= (model.walls.psi[k] * pi * inv_rho0_2 * W.dw_over_r(xik.norm())) * xik;
+                a -= (model.walls.psi[k] * 2 * pi * inv_rho0_2 * W.dw_over_r(xik.norm())) * xik;
             });
         s.a_pressure[i] = a;
         s.x_pred[i] = xi + dt * (f.v[i] + dt * (s.a_other[i] + a));
@@ -71,11 +73,14 @@ PcisphReport solve_pressure_pcisph(const Model& model, State& state, Real dt) {
     const Real rho0 = model.rho0;
     const CubicKernel& W = model.kernel;
 
+    // p starts at 0 every step (method.md §4.3). A warm start from the last step's pressure
+    // (signed update, p >= 0) was tried: it smooths the pressure but left a resting column
+    // moving at 0.1-0.2 m/s RMS, so it is not used.
     f.p.assign(n, 0);
-    s.a_pressure.assign(n, Vec3::Zero());
     s.x_pred.resize(n);
     s.rho_err.resize(n);
     compute_delta(model, state, dt, s.delta);
+    s.a_pressure.assign(n, Vec3::Zero());
     parallel_for(n, [&](Index i) { s.x_pred[i] = f.x[i] + dt * (f.v[i] + dt * s.a_other[i]); });
 
     PcisphReport report;
