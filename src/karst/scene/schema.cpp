@@ -89,8 +89,8 @@ std::vector<KeySpec> make_schema() {
             "obstacle: particles fill a skin inside the shape; container: the shape is the cavity "
             "and particles fill a skin around it.",
             {"obstacle", "container"}),
-        key("/walls/[]/layers", T::Integer, "", closed(1, 4), 1,
-            "Thickness of the particle skin, in particle layers."),
+        key("/walls/[]/layers", T::Integer, "", closed(1, 4), 2,
+            "Thickness of the particle skin, in particle layers. One layer lets fast particles slip through between steps; two is the safe default."),
 
         key("/output", T::Object, "", any(), json::object(), "What is written, and how often."),
         key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0, "Frames per simulated second."),

@@ -7,16 +7,26 @@ namespace karst {
 
 namespace {
 
-/// a_i^p = -sum_j m_j (p_i + p_j) / rho0^2 grad W_ij - sum_k Psi_k 2 p_i / rho0^2 grad W_ik at the
-/// current positions. The wall term mirrors the pressure (p_k = p_i, the variant method.md §4.3
-/// names) [D]: with p_i alone a wall-adjacent particle needs twice the hydrostatic pressure to
-/// carry the column above it, and the hydrostatic test fails by 100 % in the first layer. Then the prediction
-/// x*_i = x_i + dt (v_i + dt (a_other + a_p)) for the next density pass.
+/// a_i^p = -sum_j m_j (p_i + p_j) / rho0^2 grad W_ij - sum_k Psi_k (p_i + p_ik) / rho0^2 grad W_ik
+/// at the current positions, then the prediction x*_i = x_i + dt (v_i + dt (a_other + a_p)) for
+/// the next density pass.
+///
+/// Wall pressure [D]: method.md §4.3 writes the wall term with p_i alone; the variant it names,
+/// mirroring (p_ik = p_i), is needed because with p_i alone a wall-adjacent particle must carry
+/// twice the hydrostatic pressure (measured: 9970 Pa against 4807 Pa in the first layer). Plain
+/// mirroring still assumes a flat pressure inside the wall, so next to a side wall the particle
+/// loses the vertical gradient its missing fluid neighbours would have given: in a 10-particle
+/// wide column the z-gradient normalisation sum_j V_j x_ji,z dW/dz fell to 0.93 and the whole
+/// column settled 5 % over rho0 g depth. So the mirrored pressure is extrapolated
+/// hydrostatically, p_ik = max(p_i + rho0 g.(x_k - x_i), 0), after Band et al. 2018 ("Pressure
+/// boundaries for implicit incompressible SPH", their extrapolation without the acceleration
+/// term). The pair force stays equal and opposite, so the reaction on the wall is exact.
 void pressure_acceleration_and_prediction(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const CubicKernel& W = model.kernel;
     const Real inv_rho0_2 = 1 / (model.rho0 * model.rho0);
+    const Vec3 rho0_g = model.rho0 * model.scene.gravity;
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i];
         const Real pi = f.p[i];
@@ -28,7 +38,8 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
         if (pi != 0)
             s.fluid_wall.for_each(i, [&](Index k) {
                 const Vec3 xik = xi - model.walls.x[k];
-                a -= (model.walls.psi[k] * 2 * pi * inv_rho0_2 * W.dw_over_r(xik.norm())) * xik;
+                const Real pik = std::max(pi - rho0_g.dot(xik), Real(0));
+                a -= (model.walls.psi[k] * (pi + pik) * inv_rho0_2 * W.dw_over_r(xik.norm())) * xik;
             });
         s.a_pressure[i] = a;
         s.x_pred[i] = xi + dt * (f.v[i] + dt * (s.a_other[i] + a));
