@@ -1,0 +1,106 @@
+#pragma once
+// The Biot poroelastic problem on a fragment's tet mesh and its staggered solution
+// (method.md §5.3, M22): P1 tets, element matrices K, Q, H, lumped storage and volume, and the
+// fixed-stress split (L = B^2 / K_dr) or, for comparison, the paper's fixed-strain order (L = 0).
+#include "karst/pfem/tet_mesh.hpp"
+
+#include <cstdint>
+#include <memory>
+
+namespace karst {
+
+struct BiotMaterial {
+    Real youngs_modulus = 1e9;   ///< drained skeleton, Pa
+    Real poisson_ratio = 0.25;
+    Real biot_coefficient = 1;   ///< B = 1 - K_dr / K_s
+    Real storage = 0;            ///< 1/M = phi/K_f + (B - phi)/K_s, 1/Pa
+    Real fluid_density = 1000;   ///< rho0 of the gravity flux, kg/m^3
+    Real bulk_density = 2000;    ///< rho_bulk of the body force, kg/m^3
+
+    Real lame_lambda() const { return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)); }
+    Real shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
+    Real drained_bulk_modulus() const { return lame_lambda() + 2 * shear_modulus() / 3; }
+    /// Kim et al.'s coupling strength tau = B^2 M / K_dr: the fixed-strain split needs tau < 1.
+    Real coupling_strength() const { return biot_coefficient * biot_coefficient / (storage * drained_bulk_modulus()); }
+};
+
+/// Displacement components fixed at a node, as bits.
+enum FixedAxes : std::uint8_t { FixX = 1, FixY = 2, FixZ = 4, FixAll = 7 };
+
+/// Everything a Biot call needs besides the fields. Arrays are per node unless said otherwise;
+/// empty optional arrays mean "none" (zero).
+struct BiotProblem {
+    BiotMaterial material;
+    std::vector<Mat3> mobility;          ///< per tet: k_r K / eta, m^2/(Pa s)
+    std::vector<std::uint8_t> fixed;     ///< FixedAxes bits (u = prescribed_u there)
+    std::vector<Vec3> prescribed_u;      ///< optional, m
+    std::vector<char> drained;           ///< p prescribed (drained boundary)
+    std::vector<Real> drained_pressure;  ///< optional, Pa
+    std::vector<Vec3> nodal_force;       ///< optional external loads (tractions, fluid), N
+    Vec3 gravity = Vec3::Zero();         ///< m/s^2
+    /// A fragment without anchors: add eps diag(K) to remove the six rigid modes (§5.3).
+    bool free_body = false;
+    Real rigid_mode_spring = 1e-8;
+};
+
+enum class Splitting { FixedStress, FixedStrain };
+
+struct BiotOptions {
+    Splitting splitting = Splitting::FixedStress;
+    int max_iterations = 5;   ///< M22: k_max
+    Real tolerance = 1e-3;    ///< M22 stopping test on relative changes of p and u
+};
+
+struct BiotFields {
+    std::vector<Vec3> u;  ///< m, body frame
+    std::vector<Real> p;  ///< Pa
+};
+
+struct BiotCallReport {
+    int iterations = 0;
+    bool converged = false;
+    std::vector<Real> p_change, u_change;  ///< relative change at each iteration
+    Real seconds_flow_factorisation = 0, seconds_iterations = 0;
+};
+
+/// Owns the assembled, Dirichlet-reduced matrices and their factorisations (CHOLMOD). The
+/// elasticity matrix is factorised once per mesh (in the constructor); the flow matrix once per
+/// call, since dt and the mobility may change.
+class BiotSolver {
+public:
+    BiotSolver(const TetMesh& mesh, BiotProblem problem, BiotOptions options = {});
+    ~BiotSolver();
+    BiotSolver(BiotSolver&&) noexcept;
+    BiotSolver& operator=(BiotSolver&&) noexcept;
+
+    /// One Biot call over dt (backward Euler): fields hold u^n, p^n on entry (p^n seeded from SPH
+    /// by the caller) and u^{n+1}, p^{n+1} on return.
+    BiotCallReport advance(Real dt, BiotFields& fields);
+
+    /// New per-tet mobility (M24 feedback); H is reassembled at the next call.
+    void set_mobility(std::vector<Mat3> mobility);
+
+    const BiotProblem& problem() const;
+    Real seconds_assembly() const;
+    Real seconds_elastic_factorisation() const;
+    Index displacement_unknowns() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+/// Nodal forces of a uniform traction (Pa, world frame) on the boundary facets whose three nodes
+/// all satisfy `on_region`: each facet gives area/3 times the traction to each of its nodes.
+template <class Predicate>
+std::vector<Vec3> traction_loads(const TetMesh& mesh, const Vec3& traction, const Predicate& on_region) {
+    std::vector<Vec3> force(mesh.node_count(), Vec3::Zero());
+    for (const Triangle& t : mesh.boundary) {
+        if (!on_region(mesh.nodes[t[0]]) || !on_region(mesh.nodes[t[1]]) || !on_region(mesh.nodes[t[2]])) continue;
+        const Real area = mesh.area_vector(t).norm();
+        for (Index a : t) force[a] += traction * (area / 3);
+    }
+    return force;
+}
+
+}  // namespace karst

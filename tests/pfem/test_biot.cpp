@@ -1,0 +1,216 @@
+// The Biot solver (method.md §5.3): patch test, cantilever against Timoshenko, Terzaghi
+// consolidation against the series solution, and fixed-stress against fixed-strain splitting.
+#include "karst/pfem/biot.hpp"
+#include "karst/pfem/box_nodes.hpp"
+#include "karst/pfem/nodal_stress.hpp"
+
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+namespace karst {
+namespace {
+
+constexpr Real pi = std::numbers::pi;
+
+TetMesh box_mesh(const Vec3& lo, const Vec3& hi, Real dx) {
+    const auto nodes = box_lattice_nodes(lo, hi, dx);
+    return build_tet_mesh(nodes, std::vector<Real>(nodes.size(), dx), MeshOptions{});
+}
+
+bool near(Real a, Real b) { return std::abs(a - b) < 1e-9; }
+
+/// A problem with no pore pressure (all nodes drained at p = 0): pure elasticity.
+BiotProblem elastic_problem(const TetMesh& mesh, Real E, Real nu) {
+    BiotProblem p;
+    p.material.youngs_modulus = E, p.material.poisson_ratio = nu, p.material.bulk_density = 0;
+    p.mobility.assign(mesh.tet_count(), Mat3::Identity());
+    p.drained.assign(mesh.node_count(), 1);
+    p.fixed.assign(mesh.node_count(), 0);
+    return p;
+}
+
+TEST(Biot, PatchTestReproducesUniformStrainExactly) {
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(1, 0.6, 0.8), 0.2);
+    BiotProblem problem = elastic_problem(mesh, 1e7, 0.3);
+    Mat3 strain;
+    strain << 1e-3, 2e-4, -1e-4, 2e-4, -5e-4, 3e-4, -1e-4, 3e-4, 8e-4;
+    problem.prescribed_u.resize(mesh.node_count());
+    std::vector<char> on_boundary(mesh.node_count(), 0);
+    for (const Triangle& t : mesh.boundary)
+        for (Index a : t) on_boundary[a] = 1;
+    for (Index a = 0; a < mesh.node_count(); ++a) {
+        problem.prescribed_u[a] = strain * mesh.nodes[a];
+        if (on_boundary[a]) problem.fixed[a] = FixAll;
+    }
+    const Index interior = std::count(on_boundary.begin(), on_boundary.end(), 0);
+    ASSERT_GT(interior, 20);
+    BiotSolver solver(mesh, problem);
+    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
+    solver.advance(1.0, fields);
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        ASSERT_LT((fields.u[a] - strain * mesh.nodes[a]).norm(), 1e-12) << "node " << a;
+    const NodalStress stress = nodal_stress(mesh, problem.material, fields);
+    const BiotMaterial& m = problem.material;
+    const Mat3 expected = m.lame_lambda() * strain.trace() * Mat3::Identity() + 2 * m.shear_modulus() * strain;
+    for (Index a = 0; a < mesh.node_count(); ++a) ASSERT_LT((stress.effective[a] - expected).norm(), 1e-6 * expected.norm());
+}
+
+/// Tip deflection of a cantilever (clamped at x = 0, shear load P at x = L) against Timoshenko's
+/// beam theory with Cowper's shear coefficient.
+Real cantilever_tip_ratio(Real dx) {
+    const Real L = 1, b = 0.2, H = 0.2, E = 1e7, nu = 0, P = -100;
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(L, b, H), dx);
+    BiotProblem problem = elastic_problem(mesh, E, nu);
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        if (mesh.nodes[a][0] == 0) problem.fixed[a] = FixAll;
+    problem.nodal_force = traction_loads(mesh, Vec3(0, 0, P / (b * H)), [&](const Vec3& x) { return x[0] == L; });
+    BiotSolver solver(mesh, problem);
+    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
+    solver.advance(1.0, fields);
+    Real tip = 0;
+    int count = 0;
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        if (mesh.nodes[a][0] == L) tip += fields.u[a][2], ++count;
+    tip /= count;
+    const Real I = b * H * H * H / 12, A = b * H, G = E / (2 * (1 + nu)), kappa = 10 * (1 + nu) / (12 + 11 * nu);
+    const Real timoshenko = P * L * L * L / (3 * E * I) + P * L / (kappa * G * A);
+    return tip / timoshenko;
+}
+
+TEST(Biot, CantileverTipDeflectionWithinFivePercentOfTimoshenko) {
+    const Real coarse = cantilever_tip_ratio(0.05), fine = cantilever_tip_ratio(0.025);
+    // Linear tets are too stiff in bending; refinement must approach the beam from below.
+    EXPECT_LT(coarse, fine);
+    EXPECT_NEAR(fine, 1.0, 0.05) << "coarse (dx 0.05) ratio " << coarse;
+}
+
+/// MOOSE porous_flow's terzaghi.i: h = 10, lambda = 2, mu = 3 (K_dr = 4), K_f = 8, k/eta = 1.5,
+/// phi = 0.1, B = 0.6, so 1/M = 0.0625, c_v = 13.95, p0 = 0.6977; load q = 1 on a drained top.
+struct Terzaghi {
+    static constexpr Real h = 10, q = 1, lambda = 2, mu = 3, B = 0.6, storage = 0.0625, mobility = 1.5;
+    static constexpr Real m_v = 1 / (lambda + 2 * mu);  // confined compressibility
+    static constexpr Real c_v = mobility / (storage + B * B * m_v);
+    static constexpr Real p0 = B * m_v * q / (storage + B * B * m_v);
+
+    /// Pore pressure at height z above the impermeable base.
+    static Real pressure(Real z, Real t) {
+        Real p = 0;
+        for (int k = 0; k < 200; ++k) {
+            const Real n = 2 * k + 1;
+            p += (k % 2 ? -1 : 1) / n * std::cos(n * pi * z / (2 * h)) * std::exp(-n * n * pi * pi * c_v * t / (4 * h * h));
+        }
+        return 4 * p0 / pi * p;
+    }
+    /// Settlement of the top (downward positive).
+    static Real settlement(Real t) {
+        const Real initial = q * m_v * h * storage / (storage + B * B * m_v), final = q * m_v * h;
+        Real remaining = 0;
+        for (int k = 0; k < 200; ++k) {
+            const Real n = 2 * k + 1;
+            remaining += 8 / (n * n * pi * pi) * std::exp(-n * n * pi * pi * c_v * t / (4 * h * h));
+        }
+        return initial + (final - initial) * (1 - remaining);
+    }
+};
+
+TEST(Biot, TerzaghiConsolidationMatchesTheSeriesSolution) {
+    EXPECT_NEAR(Terzaghi::c_v, 13.95, 0.01);
+    EXPECT_NEAR(Terzaghi::p0, 0.6977, 1e-4);
+    const Real width = 1, dx = 0.25, h = Terzaghi::h;
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(width, width, h), dx);
+    BiotProblem problem;
+    BiotMaterial& m = problem.material;
+    m.youngs_modulus = Terzaghi::mu * (3 * Terzaghi::lambda + 2 * Terzaghi::mu) / (Terzaghi::lambda + Terzaghi::mu);
+    m.poisson_ratio = Terzaghi::lambda / (2 * (Terzaghi::lambda + Terzaghi::mu));
+    m.biot_coefficient = Terzaghi::B, m.storage = Terzaghi::storage, m.bulk_density = 0;
+    ASSERT_NEAR(m.drained_bulk_modulus(), 4, 1e-12);
+    problem.mobility.assign(mesh.tet_count(), Terzaghi::mobility * Mat3::Identity());
+    problem.fixed.assign(mesh.node_count(), 0);
+    problem.drained.assign(mesh.node_count(), 0);
+    for (Index a = 0; a < mesh.node_count(); ++a) {
+        const Vec3& x = mesh.nodes[a];
+        if (x[0] == 0 || x[0] == width) problem.fixed[a] |= FixX;  // rollers on the sides
+        if (x[1] == 0 || x[1] == width) problem.fixed[a] |= FixY;
+        if (x[2] == 0) problem.fixed[a] |= FixZ;  // base
+        if (x[2] == h) problem.drained[a] = 1;    // drained top
+    }
+    problem.nodal_force = traction_loads(mesh, Vec3(0, 0, -Terzaghi::q), [&](const Vec3& x) { return x[2] == h; });
+    BiotSolver solver(mesh, problem);
+    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
+
+    // Three times spanning the consolidation: T_v = c t / h^2 = 0.05, 0.2, 0.5 (U = 25 %, 50 %, 76 %).
+    const Real dt = 0.005;
+    Real t = 0;
+    int worst_iterations = 0;
+    for (Real Tv : {0.05, 0.2, 0.5}) {
+        const Real t_check = Tv * h * h / Terzaghi::c_v;
+        while (t < t_check - 1e-12) {
+            const BiotCallReport r = solver.advance(std::min(dt, t_check - t), fields);
+            worst_iterations = std::max(worst_iterations, r.iterations);
+            t += std::min(dt, t_check - t);
+        }
+        Real err2 = 0, ref2 = 0, top = 0;
+        int top_count = 0;
+        for (Index a = 0; a < mesh.node_count(); ++a) {
+            const Real exact = Terzaghi::pressure(mesh.nodes[a][2], t);
+            err2 += (fields.p[a] - exact) * (fields.p[a] - exact), ref2 += exact * exact;
+            if (mesh.nodes[a][2] == h) top -= fields.u[a][2], ++top_count;
+        }
+        EXPECT_LT(std::sqrt(err2 / ref2), 0.03) << "pore pressure, T_v = " << Tv;
+        EXPECT_NEAR(top / top_count, Terzaghi::settlement(t), 0.03 * Terzaghi::settlement(t)) << "settlement, T_v = " << Tv;
+    }
+    EXPECT_LE(worst_iterations, 5);
+}
+
+/// A confined column, nearly undrained (low mobility) with a stiff fluid: tau = B^2 M / K_dr = 1.5.
+struct UndrainedColumn {
+    TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(0.5, 0.5, 1), 0.125);
+    BiotProblem problem;
+    UndrainedColumn() {
+        BiotMaterial& m = problem.material;
+        m.youngs_modulus = 1e8, m.poisson_ratio = 0.4, m.biot_coefficient = 1, m.bulk_density = 0;
+        m.storage = 1 / (1.5 * m.drained_bulk_modulus());
+        problem.mobility.assign(mesh.tet_count(), 1e-12 * Mat3::Identity());
+        problem.fixed.assign(mesh.node_count(), 0);
+        problem.drained.assign(mesh.node_count(), 0);
+        for (Index a = 0; a < mesh.node_count(); ++a) {
+            const Vec3& x = mesh.nodes[a];
+            if (x[0] == 0 || x[0] == 0.5) problem.fixed[a] |= FixX;
+            if (x[1] == 0 || x[1] == 0.5) problem.fixed[a] |= FixY;
+            if (x[2] == 0) problem.fixed[a] |= FixZ;
+            if (x[2] == 1) problem.drained[a] = 1;
+        }
+        problem.nodal_force = traction_loads(mesh, Vec3(0, 0, -1e6), [&](const Vec3& x) { return x[2] == 1; });
+    }
+    BiotFields zero() const { return {std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)}; }
+};
+
+TEST(Biot, FixedStressConvergesWhereFixedStrainDivergesWhenTauExceedsOne) {
+    UndrainedColumn column;
+    ASSERT_NEAR(column.problem.material.coupling_strength(), 1.5, 1e-12);
+    // Reference: fixed-stress iterated to round-off.
+    BiotFields reference = column.zero();
+    BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 100, 1e-13}).advance(1.0, reference);
+
+    BiotFields stress_split = column.zero();
+    const BiotCallReport fs = BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 5, 1e-3}).advance(1.0, stress_split);
+    EXPECT_TRUE(fs.converged);
+    EXPECT_LE(fs.iterations, 5);
+    Real p_err = 0, p_ref = 0;
+    for (Index a = 0; a < column.mesh.node_count(); ++a)
+        p_err = std::max(p_err, std::abs(stress_split.p[a] - reference.p[a])), p_ref = std::max(p_ref, std::abs(reference.p[a]));
+    EXPECT_LT(p_err, 1e-2 * p_ref);
+    // Nearly undrained: the fluid takes B M / (K_v + B^2 M) of the load, K_v = lambda + 2 mu.
+    const BiotMaterial& m = column.problem.material;
+    const Real M = 1 / m.storage, undrained = 1e6 * M / (m.lame_lambda() + 2 * m.shear_modulus() + M);
+    EXPECT_NEAR(reference.p[0], undrained, 0.05 * undrained) << "node 0 (base corner)";
+
+    BiotFields strain_split = column.zero();
+    const BiotCallReport fx = BiotSolver(column.mesh, column.problem, {Splitting::FixedStrain, 50, 1e-3}).advance(1.0, strain_split);
+    EXPECT_FALSE(fx.converged) << "the fixed-strain split needs tau < 1";
+    EXPECT_GT(fx.p_change.back(), 0.1) << "fixed-strain iterates still change by over 10 % after 50 iterations";
+}
+
+}  // namespace
+}  // namespace karst
