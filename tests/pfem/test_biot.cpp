@@ -142,12 +142,12 @@ TEST(Biot, TerzaghiConsolidationMatchesTheSeriesSolution) {
     // Three times spanning the consolidation: T_v = c t / h^2 = 0.05, 0.2, 0.5 (U = 25 %, 50 %, 76 %).
     const Real dt = 0.005;
     Real t = 0;
-    int worst_iterations = 0;
+    Real worst_final_change = 0;
     for (Real Tv : {0.05, 0.2, 0.5}) {
         const Real t_check = Tv * h * h / Terzaghi::c_v;
         while (t < t_check - 1e-12) {
             const BiotCallReport r = solver.advance(std::min(dt, t_check - t), fields);
-            worst_iterations = std::max(worst_iterations, r.iterations);
+            worst_final_change = std::max(worst_final_change, std::max(r.p_change.back(), r.u_change.back()));
             t += std::min(dt, t_check - t);
         }
         Real err2 = 0, ref2 = 0, top = 0;
@@ -160,7 +160,8 @@ TEST(Biot, TerzaghiConsolidationMatchesTheSeriesSolution) {
         EXPECT_LT(std::sqrt(err2 / ref2), 0.03) << "pore pressure, T_v = " << Tv;
         EXPECT_NEAR(top / top_count, Terzaghi::settlement(t), 0.03 * Terzaghi::settlement(t)) << "settlement, T_v = " << Tv;
     }
-    EXPECT_LE(worst_iterations, 5);
+    // Five fixed-stress iterations leave each call's increment within 1 % (tau = 1.44 here).
+    EXPECT_LT(worst_final_change, 0.01);
 }
 
 /// A confined column, nearly undrained (low mobility) with a stiff fluid: tau = B^2 M / K_dr = 1.5.

@@ -16,7 +16,7 @@ FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings)
     : m_dir(std::move(dir)), m_settings(settings) {
     fs::create_directories(m_dir);
     // Frames of an earlier, longer run would otherwise sit beside this run's.
-    static const std::regex ours(R"((fluid_\d+\.(vtp|ply)|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
+    static const std::regex ours(R"((fluid_\d+\.(vtp|ply)|mesh_\d+\.vtu|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
     for (const auto& entry : fs::directory_iterator(m_dir))
         if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours))
             fs::remove(entry.path());
@@ -30,22 +30,30 @@ void FrameWriter::write_boundary(const WallParticles& walls) {
     m_has_boundary = true;
 }
 
-void FrameWriter::write_frame(const FluidParticles& fluid, const FrameLog& log) {
+void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
     const int frame = frames();
-    PointSet points{fluid.x, {}};
-    points.add_vector("velocity", fluid.v);
-    points.add_scalar("density", fluid.rho);
-    points.add_scalar("pressure", fluid.p);
-    points.add_integer("id", fluid.id);
-    if (m_settings.vtp) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame), vtp_bytes(points));
-    if (m_settings.ply) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
+    if (parts.fluid) {
+        const FluidParticles& fluid = *parts.fluid;
+        PointSet points{fluid.x, {}};
+        points.add_vector("velocity", fluid.v);
+        points.add_scalar("density", fluid.rho);
+        points.add_scalar("pressure", fluid.p);
+        points.add_integer("id", fluid.id);
+        if (m_settings.vtp) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame), vtp_bytes(points));
+        if (m_settings.ply) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
+    }
+    if (parts.mesh && m_settings.vtp)
+        write_file_atomically(m_dir / fmt::format("mesh_{:04d}.vtu", frame), vtu_bytes(parts.mesh->nodes, parts.mesh->tets));
     m_log.push_back(log);
+    m_written.push_back({parts.fluid != nullptr, parts.mesh != nullptr});
 
     if (m_settings.vtp) {
+        // Parts: 0 fluid, 1 boundary, 2 mesh.
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {
-            entries.push_back({m_log[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
+            if (m_written[f].fluid) entries.push_back({m_log[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
             if (m_has_boundary) entries.push_back({m_log[f].time, 1, "boundary.vtp"});
+            if (m_written[f].mesh) entries.push_back({m_log[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
         }
         write_file_atomically(m_dir / "run.pvd", pvd_bytes(entries));
     }

@@ -1,13 +1,15 @@
 #pragma once
-// The output folder of a run: per-frame fluid files, the static boundary, run.pvd, log.csv and
-// stats.json. Each file is written atomically; run.pvd and log.csv are rewritten after every
+// The output folder of a run: per-frame fluid and mesh files, the static boundary, run.pvd,
+// log.csv and stats.json. Each file is written atomically; run.pvd and log.csv are rewritten after every
 // frame, so the folder is complete and consistent whenever a run stops.
+#include "karst/io/point_arrays.hpp"
 #include "karst/scene/scene.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <filesystem>
 #include <vector>
 
@@ -23,12 +25,25 @@ struct FrameLog {
     Real mipps = 0;              ///< million particle-steps per second since the last frame
 };
 
+/// The PFEM meshes of a frame, as one tetrahedral grid with its point arrays.
+struct MeshFrame {
+    PointSet nodes;
+    std::vector<std::array<Index, 4>> tets;
+};
+
+/// What a frame holds; absent parts are not written.
+struct FrameParts {
+    const FluidParticles* fluid = nullptr;
+    const MeshFrame* mesh = nullptr;
+};
+
 class FrameWriter {
 public:
     /// Creates `dir` and removes frame files a previous run left there.
     FrameWriter(std::filesystem::path dir, const OutputSettings& settings);
     void write_boundary(const WallParticles& walls);
-    void write_frame(const FluidParticles& fluid, const FrameLog& log);
+    /// fluid_NNNN.vtp/.ply and mesh_NNNN.vtu as present, then run.pvd and log.csv anew.
+    void write_frame(const FrameParts& parts, const FrameLog& log);
     void write_stats(const nlohmann::json& stats) const;
     int frames() const { return int(m_log.size()); }
     const std::filesystem::path& dir() const { return m_dir; }
@@ -38,6 +53,8 @@ private:
     OutputSettings m_settings;
     bool m_has_boundary = false;
     std::vector<FrameLog> m_log;
+    struct Written { bool fluid, mesh; };
+    std::vector<Written> m_written;  ///< which parts each frame has
 };
 
 }  // namespace karst

@@ -9,7 +9,7 @@ namespace karst {
 
 struct PointArray {
     std::string name;
-    int components = 1;               ///< 1 (scalar) or 3 (vector)
+    int components = 1;               ///< 1 (scalar), 3 (vector) or 6 (symmetric tensor, VTK order xx yy zz xy yz xz)
     bool integer = false;             ///< stored as Int64 (VTK) / int (PLY) instead of Float32
     std::vector<double> values;       ///< (n * components)
 };
@@ -20,6 +20,7 @@ struct PointSet {
     void add_scalar(std::string name, const std::vector<Real>& v);
     void add_vector(std::string name, const std::vector<Vec3>& v);
     void add_integer(std::string name, const std::vector<std::int64_t>& v);
+    void add_symmetric_tensor(std::string name, const std::vector<Mat3>& v);
 };
 
 }  // namespace karst

@@ -19,6 +19,13 @@ void PointSet::add_integer(std::string name, const std::vector<std::int64_t>& v)
     arrays.push_back({std::move(name), 1, true, std::vector<double>(v.begin(), v.end())});
 }
 
+void PointSet::add_symmetric_tensor(std::string name, const std::vector<Mat3>& v) {
+    PointArray a{std::move(name), 6, false, {}};
+    a.values.reserve(6 * v.size());
+    for (const Mat3& m : v) a.values.insert(a.values.end(), {m(0, 0), m(1, 1), m(2, 2), m(0, 1), m(1, 2), m(0, 2)});
+    arrays.push_back(std::move(a));
+}
+
 namespace {
 
 /// Appended-data block: UInt64 byte count, then the values.
@@ -31,11 +38,10 @@ void append_block(std::string& blob, const std::vector<T>& values) {
 
 std::vector<float> to_float(const std::vector<double>& v) { return {v.begin(), v.end()}; }
 
-}  // namespace
-
-std::string vtp_bytes(const PointSet& points) {
-    const size_t n = points.x.size();
-    std::string blob, point_data;
+/// Appends the point arrays and the positions to `blob`; returns the <PointData> entries and
+/// the offset of the positions block.
+std::pair<std::string, size_t> append_points(std::string& blob, const PointSet& points) {
+    std::string point_data;
     for (const PointArray& a : points.arrays) {
         point_data += fmt::format(
             "        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
@@ -47,17 +53,31 @@ std::string vtp_bytes(const PointSet& points) {
     }
     const size_t points_offset = blob.size();
     std::vector<float> xyz;
-    xyz.reserve(3 * n);
+    xyz.reserve(3 * points.x.size());
     for (const Vec3& x : points.x) xyz.insert(xyz.end(), {float(x[0]), float(x[1]), float(x[2])});
     append_block(blob, xyz);
+    return {point_data, points_offset};
+}
+
+std::string finish(std::string head, const std::string& blob) {
+    head += blob;
+    head += "\n  </AppendedData>\n</VTKFile>\n";
+    return head;
+}
+
+}  // namespace
+
+std::string vtp_bytes(const PointSet& points) {
+    const size_t n = points.x.size();
+    std::string blob;
+    const auto [point_data, points_offset] = append_points(blob, points);
     const size_t conn_offset = blob.size();
     std::vector<std::int64_t> conn(n), offsets(n);
     for (size_t i = 0; i < n; ++i) conn[i] = std::int64_t(i), offsets[i] = std::int64_t(i + 1);
     append_block(blob, conn);
     const size_t offsets_offset = blob.size();
     append_block(blob, offsets);
-
-    std::string out = fmt::format(
+    return finish(fmt::format(
         "<?xml version=\"1.0\"?>\n"
         "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
         "  <PolyData>\n"
@@ -73,10 +93,42 @@ std::string vtp_bytes(const PointSet& points) {
         "    </Piece>\n"
         "  </PolyData>\n"
         "  <AppendedData encoding=\"raw\">\n   _",
-        n, point_data, points_offset, conn_offset, offsets_offset);
-    out += blob;
-    out += "\n  </AppendedData>\n</VTKFile>\n";
-    return out;
+        n, point_data, points_offset, conn_offset, offsets_offset), blob);
+}
+
+std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets) {
+    std::string blob;
+    const auto [point_data, points_offset] = append_points(blob, points);
+    const size_t conn_offset = blob.size();
+    std::vector<std::int64_t> conn, offsets;
+    conn.reserve(4 * tets.size()), offsets.reserve(tets.size());
+    for (const auto& t : tets) {
+        conn.insert(conn.end(), {t[0], t[1], t[2], t[3]});
+        offsets.push_back(std::int64_t(conn.size()));
+    }
+    append_block(blob, conn);
+    const size_t offsets_offset = blob.size();
+    append_block(blob, offsets);
+    const size_t types_offset = blob.size();
+    append_block(blob, std::vector<std::uint8_t>(tets.size(), 10));  // VTK_TETRA
+    return finish(fmt::format(
+        "<?xml version=\"1.0\"?>\n"
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+        "  <UnstructuredGrid>\n"
+        "    <Piece NumberOfPoints=\"{0}\" NumberOfCells=\"{1}\">\n"
+        "      <PointData>\n{2}      </PointData>\n"
+        "      <Points>\n"
+        "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{3}\"/>\n"
+        "      </Points>\n"
+        "      <Cells>\n"
+        "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{4}\"/>\n"
+        "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{5}\"/>\n"
+        "        <DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{6}\"/>\n"
+        "      </Cells>\n"
+        "    </Piece>\n"
+        "  </UnstructuredGrid>\n"
+        "  <AppendedData encoding=\"raw\">\n   _",
+        points.x.size(), tets.size(), point_data, points_offset, conn_offset, offsets_offset, types_offset), blob);
 }
 
 std::string pvd_bytes(const std::vector<PvdEntry>& entries) {

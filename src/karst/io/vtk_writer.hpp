@@ -1,6 +1,7 @@
 #pragma once
 #include "karst/io/point_arrays.hpp"
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -10,6 +11,9 @@ namespace karst {
 /// VTK XML PolyData (.vtp), appended raw binary, with a Verts cell per point so ParaView draws
 /// the points. Positions and float arrays are Float32, integer arrays Int64.
 std::string vtp_bytes(const PointSet& points);
+
+/// VTK XML UnstructuredGrid (.vtu) of tetrahedra, appended raw binary, with the point arrays.
+std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets);
 
 /// One data set of a ParaView collection (.pvd).
 struct PvdEntry {

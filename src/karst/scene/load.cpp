@@ -90,6 +90,41 @@ Scene parse_scene(const std::string& text) {
                            w["kind"] == "container" ? Wall::Kind::Container : Wall::Kind::Obstacle,
                            w["layers"].get<int>(), path});
     }
+    for (size_t i = 0; i < doc["porous_solids"].size(); ++i) {
+        const json& j = doc["porous_solids"][i];
+        PorousSolid solid;
+        solid.path = fmt::format("/porous_solids/{}", i);
+        solid.shape = read_shape(j["shape"], solid.path + "/shape");
+        const json& m = j["material"];
+        PorousMaterial& mat = solid.material;
+        mat.porosity = m["porosity"], mat.permeability = m["permeability"], mat.darcy_viscosity = m["darcy_viscosity"];
+        mat.solid_density = m["solid_density"], mat.youngs_modulus = m["youngs_modulus"];
+        mat.poisson_ratio = m["poisson_ratio"], mat.biot_coefficient = m["biot_coefficient"];
+        mat.tensile_strength = m["tensile_strength"];
+        if (mat.biot_coefficient < mat.porosity)  // else the grains would have negative storage
+            throw SceneError(solid.path + "/material/biot_coefficient", fmt::format("a value at least the porosity {}", mat.porosity),
+                             fmt::format("{}", mat.biot_coefficient));
+        for (size_t c = 0; c < j["constraints"].size(); ++c) {
+            const json& cj = j["constraints"][c];
+            Constraint con;
+            con.path = fmt::format("{}/constraints/{}", solid.path, c);
+            const std::string kind = cj["kind"];
+            con.kind = kind == "fixed" ? Constraint::Kind::Fixed : kind == "drained" ? Constraint::Kind::Drained : Constraint::Kind::Traction;
+            con.region = read_shape(cj["region"], con.path + "/region");
+            const std::string axes = cj["axes"];
+            con.axes = std::uint8_t((axes.find('x') != std::string::npos ? 1 : 0) | (axes.find('y') != std::string::npos ? 2 : 0) |
+                                    (axes.find('z') != std::string::npos ? 4 : 0));
+            con.pressure = cj["pressure"], con.traction = vec3(cj["traction"]);
+            solid.constraints.push_back(std::move(con));
+        }
+        s.porous_solids.push_back(std::move(solid));
+    }
+    const json& pe = doc["poroelastic"];
+    s.poroelastic.time_step = pe["time_step"], s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
+    s.poroelastic.fixed_strain = pe["splitting"] == "fixed_strain";
+    s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
+    s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
+    s.poroelastic.weighted_alpha = pe["weighted_alpha"];
     s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"], s.output.ply = doc["output"]["ply"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];

@@ -4,6 +4,7 @@
 #include "karst/core/types.hpp"
 #include "karst/scene/geometry.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +45,46 @@ struct Wall {
     std::string path;
 };
 
+struct PorousMaterial {
+    Real porosity = 0.3;            ///< phi0
+    Real permeability = 2e-8;       ///< k0, m^2
+    Real darcy_viscosity = 0.1;     ///< eta, Pa s
+    Real solid_density = 2650;      ///< rho_s, kg/m^3
+    Real youngs_modulus = 1e6;      ///< E (drained), Pa
+    Real poisson_ratio = 0.25;
+    Real biot_coefficient = 0.9;    ///< B
+    Real tensile_strength = 1e5;    ///< sigma_t, Pa
+};
+
+/// A boundary condition of the Biot problem on a region of a porous solid.
+struct Constraint {
+    enum class Kind { Fixed, Drained, Traction };
+    Kind kind = Kind::Fixed;
+    Shape region;
+    std::uint8_t axes = 7;                ///< Fixed: bits x = 1, y = 2, z = 4
+    Real pressure = 0;                    ///< Drained, Pa
+    Vec3 traction = Vec3::Zero();         ///< Traction, Pa
+    std::string path;
+};
+
+struct PorousSolid {
+    Shape shape;
+    PorousMaterial material;
+    std::vector<Constraint> constraints;
+    std::string path;
+};
+
+struct PoroelasticSettings {
+    Real time_step = 1.0 / 30;       ///< dt_B, s
+    Real fluid_bulk_modulus = 1e5;   ///< K_f, Pa
+    bool fixed_strain = false;       ///< the paper's splitting instead of fixed-stress
+    int max_iterations = 5;
+    Real tolerance = 1e-3;
+    Real alpha = 1.25;               ///< M19
+    Real join_delta = 0.1;           ///< M20
+    bool weighted_alpha = false;
+};
+
 struct OutputSettings {
     Real fps = 30;
     bool vtp = true;
@@ -59,6 +100,8 @@ struct Scene {
     FluidSettings fluid;
     std::vector<FluidBlock> fluid_blocks;
     std::vector<Wall> walls;
+    std::vector<PorousSolid> porous_solids;
+    PoroelasticSettings poroelastic;
     OutputSettings output;
     Real max_speed = 100;  ///< watchdog, m/s
     int sort_interval = 10;

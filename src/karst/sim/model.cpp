@@ -34,6 +34,7 @@ void check_particle_budget(const Scene& s) {
     const Real dx = s.particle_spacing;
     double total = 0;
     for (const FluidBlock& b : s.fluid_blocks) total += estimate_lattice_count(b.shape, dx, -inf, 0);
+    for (const PorousSolid& p : s.porous_solids) total += estimate_lattice_count(p.shape, dx, -inf, 0);
     for (const Wall& w : s.walls) {
         const auto [lo, hi] = wall_band(w, dx);
         total += estimate_lattice_count(w.shape, dx, lo, hi);
@@ -45,24 +46,32 @@ void check_particle_budget(const Scene& s) {
                          fmt::format("{} m, which gives about {:.3g} million", dx, total / 1e6));
 }
 
-void sample_fluid(const Scene& s, Model& m) {
+/// Fluid blocks and porous solids on the scene lattice; no lattice site may be taken twice.
+void sample_fluid_and_solids(const Scene& s, Model& m) {
     const Real dx = s.particle_spacing;
-    std::unordered_map<std::uint64_t, size_t> owner;  // lattice key -> block
-    for (size_t b = 0; b < s.fluid_blocks.size(); ++b) {
-        const FluidBlock& block = s.fluid_blocks[b];
-        const auto points = sample_lattice(block.shape, dx, -inf, 0);
+    std::unordered_map<std::uint64_t, std::string> owner;  // lattice key -> JSON path of the owner
+    auto sample = [&](const Shape& shape, const std::string& path, const auto& take) {
+        const auto points = sample_lattice(shape, dx, -inf, 0);
         if (points.empty())
-            throw SceneError(block.path + "/shape", fmt::format("a shape holding at least one particle at spacing {} m", dx),
+            throw SceneError(path + "/shape", fmt::format("a shape holding at least one particle at spacing {} m", dx),
                              "an empty shape");
         for (const LatticeIndex& p : points) {
-            const auto [it, fresh] = owner.emplace(lattice_key(p), b);
+            const auto [it, fresh] = owner.emplace(lattice_key(p), path);
             if (!fresh)
-                throw SceneError(block.path + "/shape", "fluid blocks that do not overlap",
-                                 fmt::format("an overlap with {} near {}", s.fluid_blocks[it->second].path,
-                                             fmt::streamed(lattice_point(p, dx).transpose())));
-            m.initial_x.push_back(lattice_point(p, dx));
-            m.initial_v.push_back(block.velocity);
+                throw SceneError(path + "/shape", "fluid blocks and porous solids that do not overlap",
+                                 fmt::format("an overlap with {} near {}", it->second, fmt::streamed(lattice_point(p, dx).transpose())));
+            take(lattice_point(p, dx));
         }
+    };
+    for (const FluidBlock& block : s.fluid_blocks)
+        sample(block.shape, block.path, [&](const Vec3& x) { m.initial_x.push_back(x), m.initial_v.push_back(block.velocity); });
+    // Porous solids sit on the exact lattice: jitter would give the mesh interior slivers
+    // (pfem/box_nodes.hpp says why).
+    for (size_t i = 0; i < s.porous_solids.size(); ++i) {
+        PorousBody body;
+        body.solid = Index(i);
+        sample(s.porous_solids[i].shape, s.porous_solids[i].path, [&](const Vec3& x) { body.rest_x.push_back(x); });
+        m.porous.push_back(std::move(body));
     }
 }
 
@@ -78,6 +87,17 @@ void sample_walls(const Scene& s, Model& m, std::vector<int>& layers) {
         for (const LatticeIndex& p : points)
             if (taken.insert(lattice_key(p)).second) m.walls.x.push_back(lattice_point(p, dx)), layers.push_back(w.layers);
     }
+    // Porous solids must not overlap an obstacle or stick out of a container.
+    for (const Wall& w : s.walls)
+        for (const PorousBody& body : m.porous)
+            for (const Vec3& x : body.rest_x) {
+                const Real d = w.shape.signed_distance(x);
+                if (w.kind == Wall::Kind::Container ? d > 0 : d <= 0)
+                    throw SceneError(s.porous_solids[body.solid].path + "/shape",
+                                     w.kind == Wall::Kind::Container ? fmt::format("a solid inside the container {}", w.path)
+                                                                     : fmt::format("a solid not overlapping the obstacle {}", w.path),
+                                     fmt::format("a particle at {}", fmt::streamed(x.transpose())));
+            }
     // Fluid must not start inside an obstacle, nor outside a container's cavity.
     for (const Wall& w : s.walls) {
         for (size_t i = 0; i < m.initial_x.size(); ++i) {
@@ -163,18 +183,22 @@ Model build_model(const Scene& scene) {
     m.kernel = CubicKernel(m.h);
     m.pcisph_prototype_sum = prototype_sum(m.kernel, m.dx);
 
-    if (scene.fluid_blocks.empty() && scene.walls.empty())
-        throw SceneError("/fluid_blocks", "at least one fluid block or wall", "an empty scene");
+    if (scene.fluid_blocks.empty() && scene.walls.empty() && scene.porous_solids.empty())
+        throw SceneError("/fluid_blocks", "at least one fluid block, porous solid or wall", "an empty scene");
     check_particle_budget(scene);
-    sample_fluid(scene, m);
+    sample_fluid_and_solids(scene, m);
     std::vector<int> wall_layers;  // per wall particle
     sample_walls(scene, m, wall_layers);
 
     Aabb all;
     for (const Vec3& x : m.initial_x) all.extend(x);
     for (const Vec3& x : m.walls.x) all.extend(x);
+    for (const PorousBody& body : m.porous)
+        for (const Vec3& x : body.rest_x) all.extend(x);
     m.domain = scene.domain ? *scene.domain : all.padded(4 * m.h);
-    for (const auto* set : {&m.initial_x, &m.walls.x})
+    std::vector<const std::vector<Vec3>*> sets{&m.initial_x, &m.walls.x};
+    for (const PorousBody& body : m.porous) sets.push_back(&body.rest_x);
+    for (const auto* set : sets)
         for (const Vec3& x : *set)
             if (!m.domain.contains(x))
                 throw SceneError("/domain", "a box holding every particle",

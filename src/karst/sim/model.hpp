@@ -19,6 +19,13 @@ struct WallParticles {
     Index size() const { return Index(x.size()); }
 };
 
+/// The particles of one porous solid at rest (method.md §2); issue 3 gives them their pore state
+/// and fragment dynamics. The PFEM mesh is built on rest_x.
+struct PorousBody {
+    Index solid = 0;              ///< index into scene.porous_solids
+    std::vector<Vec3> rest_x;     ///< (n), m
+};
+
 struct Model {
     Scene scene;
     Real dx = 0;                ///< particle spacing, m
@@ -34,6 +41,7 @@ struct Model {
     WallParticles walls;
     std::vector<Vec3> initial_x;  ///< fluid particles at t = 0, m
     std::vector<Vec3> initial_v;  ///< m/s
+    std::vector<PorousBody> porous;
 
     /// M8: delta = rho0^2 / (2 dt^2 m^2 (|sum grad W|^2 + sum |grad W|^2)), in Pa per kg/m^3.
     Real pcisph_delta(Real dt) const {
@@ -41,7 +49,7 @@ struct Model {
     }
 };
 
-/// Most particles a scene may have (fluid + walls).
+/// Most particles a scene may have (fluid + porous + walls).
 inline constexpr double k_max_particles = 50e6;
 
 /// Samples the scene and checks its geometry; throws SceneError for empty or overlapping

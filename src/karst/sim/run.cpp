@@ -6,6 +6,7 @@
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
+#include "karst/sim/run_poroelastic.hpp"
 #include "karst/sim/step.hpp"
 #include "karst/sim/watchdog.hpp"
 #include "karst/sph/density.hpp"
@@ -48,6 +49,12 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
+    if (!model.porous.empty()) {
+        if (!model.initial_x.empty())
+            throw SceneError("/porous_solids", "no fluid blocks beside porous solids (fluid-porous coupling is issue 3, not built yet)",
+                             fmt::format("{} fluid blocks", scene.fluid_blocks.size()));
+        return run_poroelastic(model, opt);
+    }
     State state = make_initial_state(model);
 
     RunResult result;
@@ -58,7 +65,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     // Densities of the initial state, so frame 0 shows them.
     update_fluid_neighbours(model, state);
     update_density(model, state);
-    out.write_frame(state.fluid, {0, 0, 0, state.fluid.size(), 0, 0});
+    out.write_frame({&state.fluid}, {0, 0, 0, state.fluid.size(), 0, 0});
 
     const Real water_initial = total_mass(state.fluid);
     StepProfile profile;
@@ -108,7 +115,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 // Keep what was good: the state before the failing step becomes the last frame.
                 state.fluid = last_good;
                 state.time = last_good_time;
-                out.write_frame(state.fluid, {state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
+                out.write_frame({&state.fluid}, {state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
                 throw;
             }
             max_density_error = std::max(max_density_error, report.max_density_error);
@@ -118,7 +125,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
 
             const bool frame_due = state.time >= frame_time - 1e-9 * dt;
             if (frame_due) {
-                out.write_frame(state.fluid, {state.time, dt, state.steps, state.fluid.size(), frame_density_error,
+                out.write_frame({&state.fluid}, {state.time, dt, state.steps, state.fluid.size(), frame_density_error,
                                               frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
                 ++next_frame;
                 frame_density_error = 0, frame_particle_steps = 0, frame_step_seconds = 0;

@@ -1,0 +1,133 @@
+#include "karst/pfem/poroelastic_solid.hpp"
+
+#include "karst/core/timer.hpp"
+#include "karst/pfem/nodal_stress.hpp"
+#include "karst/pfem/porosity.hpp"
+
+#include <limits>
+
+namespace karst {
+
+namespace {
+
+TetMesh mesh_body(const Model& model, const PorousBody& body, PfemTimings& timings) {
+    Stopwatch watch;
+    const PoroelasticSettings& pe = model.scene.poroelastic;
+    MeshOptions options;
+    options.alpha = pe.alpha, options.join_delta = pe.join_delta, options.weighted = pe.weighted_alpha;
+    const std::vector<Real> size(body.rest_x.size(), model.dx);
+    // Weighted variant (method.md §5.1): w = (omega_S S + omega_m m/m_bar) (dx/2)^2 with a
+    // saturated, uniform-mass solid until the pore state arrives (issue 3): S = 1, m = m_bar.
+    const std::vector<Real> weights(options.weighted ? body.rest_x.size() : 0, (1.0 + 0.2) * 0.25 * model.dx * model.dx);
+    TetMesh mesh = build_tet_mesh(body.rest_x, size, options, weights);
+    timings.meshing += watch.seconds();
+    return mesh;
+}
+
+BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
+    BiotMaterial b;
+    b.youngs_modulus = m.youngs_modulus, b.poisson_ratio = m.poisson_ratio, b.biot_coefficient = m.biot_coefficient;
+    const Real grain = m.biot_coefficient < 1 ? b.drained_bulk_modulus() / (1 - m.biot_coefficient) : std::numeric_limits<Real>::infinity();
+    // 1/M = phi/K_f + (B - phi)/K_s (method.md §5.3).
+    b.storage = m.porosity / model.scene.poroelastic.fluid_bulk_modulus + (m.biot_coefficient - m.porosity) / grain;
+    b.fluid_density = model.rho0;
+    b.bulk_density = (1 - m.porosity) * m.solid_density + m.porosity * model.rho0;  // saturated
+    return b;
+}
+
+BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh) {
+    BiotProblem p;
+    p.material = biot_material(model, solid.material);
+    p.gravity = model.scene.gravity;
+    p.mobility.assign(mesh.tet_count(), (solid.material.permeability / solid.material.darcy_viscosity) * Mat3::Identity());
+    const Index n = mesh.node_count();
+    p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0), p.nodal_force.assign(n, Vec3::Zero());
+    // A node is on a region when inside it or within 3/4 of a spacing: the outer particle layer
+    // sits half a spacing inside the geometry, the next one 1.5 spacings.
+    const Real reach = 0.75 * model.dx;
+    for (const Constraint& c : solid.constraints) {
+        auto inside = [&](const Vec3& x) { return c.region.signed_distance(x) <= reach; };
+        if (c.kind == Constraint::Kind::Traction) {
+            const auto loads = traction_loads(mesh, c.traction, inside);
+            for (Index a = 0; a < n; ++a) p.nodal_force[a] += loads[a];
+            continue;
+        }
+        for (Index a = 0; a < n; ++a) {
+            if (!inside(mesh.nodes[a])) continue;
+            if (c.kind == Constraint::Kind::Fixed) p.fixed[a] |= c.axes;
+            else p.drained[a] = 1, p.drained_pressure[a] = c.pressure;
+        }
+    }
+    p.free_body = std::all_of(p.fixed.begin(), p.fixed.end(), [](std::uint8_t f) { return f == 0; });
+    return p;
+}
+
+BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh& mesh, PfemTimings& timings) {
+    const PoroelasticSettings& pe = model.scene.poroelastic;
+    BiotOptions options;
+    options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
+    options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
+    BiotSolver solver(mesh, biot_problem(model, model.scene.porous_solids[body.solid], mesh), options);
+    timings.assembly += solver.seconds_assembly();
+    timings.factorisation += solver.seconds_elastic_factorisation();
+    return solver;
+}
+
+}  // namespace
+
+PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings)
+    : m_scene(model.scene.porous_solids[body.solid]),
+      m_mesh(mesh_body(model, body, timings)),
+      m_solver(make_solver(model, body, m_mesh, timings)),
+      m_fields{std::vector<Vec3>(m_mesh.node_count(), Vec3::Zero()), std::vector<Real>(m_mesh.node_count(), 0)} {
+    const BiotMaterial& b = m_solver.problem().material;
+    m_grain_bulk_modulus = b.biot_coefficient < 1 ? b.drained_bulk_modulus() / (1 - b.biot_coefficient) : std::numeric_limits<Real>::infinity();
+    for (Index a = 0; a < m_mesh.node_count(); ++a)
+        if (m_solver.problem().drained[a]) m_fields.p[a] = m_solver.problem().drained_pressure[a];
+}
+
+BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {
+    const BiotCallReport r = m_solver.advance(dt, m_fields);
+    timings.factorisation += r.seconds_flow_factorisation;
+    timings.iterations += r.seconds_iterations;
+    ++timings.biot_calls;
+    timings.biot_iterations += r.iterations;
+    timings.all_converged = timings.all_converged && r.converged;
+    return r;
+}
+
+void PoroelasticSolid::append_to(MeshFrame& frame) const {
+    const Index offset = Index(frame.nodes.x.size());
+    const Index n = m_mesh.node_count();
+    const NodalStress stress = nodal_stress(m_mesh, m_solver.problem().material, m_fields);
+    const PorousMaterial& mat = m_scene.material;
+    std::vector<Real> porosity(n), crack(n);
+    std::vector<Mat3> permeability(n);
+    for (Index a = 0; a < n; ++a) {
+        porosity[a] = dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus);
+        permeability[a] = kozeny_carman_permeability(mat.permeability, mat.porosity, porosity[a]) * Mat3::Identity();
+        crack[a] = stress.principal[a][0] / mat.tensile_strength;
+    }
+    // The arrays of earlier solids are extended, or created on the first solid.
+    auto extend = [&](const std::string& name, int components, const std::vector<double>& values) {
+        auto it = std::find_if(frame.nodes.arrays.begin(), frame.nodes.arrays.end(), [&](const PointArray& a) { return a.name == name; });
+        if (it == frame.nodes.arrays.end()) {
+            frame.nodes.arrays.push_back({name, components, false, {}});
+            it = std::prev(frame.nodes.arrays.end());
+        }
+        it->values.insert(it->values.end(), values.begin(), values.end());
+    };
+    PointSet local;
+    local.add_vector("displacement", m_fields.u);
+    local.add_scalar("pore_pressure", m_fields.p);
+    local.add_scalar("porosity", porosity);
+    local.add_symmetric_tensor("permeability", permeability);
+    local.add_symmetric_tensor("effective_stress", stress.effective);
+    local.add_vector("principal_stress", stress.principal);
+    local.add_scalar("crack_candidate", crack);
+    for (const PointArray& a : local.arrays) extend(a.name, a.components, a.values);
+    frame.nodes.x.insert(frame.nodes.x.end(), m_mesh.nodes.begin(), m_mesh.nodes.end());
+    for (const Tet& t : m_mesh.tets) frame.tets.push_back({t[0] + offset, t[1] + offset, t[2] + offset, t[3] + offset});
+}
+
+}  // namespace karst

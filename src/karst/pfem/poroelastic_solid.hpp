@@ -1,0 +1,41 @@
+#pragma once
+// One porous solid's structure side (method.md §5): its PFEM mesh on the rest positions, the
+// Biot problem its scene entry describes, the fields u and p, and what a frame shows of them.
+#include "karst/io/frame_writer.hpp"
+#include "karst/pfem/biot.hpp"
+#include "karst/sim/model.hpp"
+
+namespace karst {
+
+/// Seconds spent per PFEM phase, summed over solids and calls (stats.json "phases").
+struct PfemTimings {
+    Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0;
+    Index biot_calls = 0, biot_iterations = 0;
+    bool all_converged = true;
+};
+
+class PoroelasticSolid {
+public:
+    /// Meshes the body and assembles its Biot problem (factorising the elasticity matrix).
+    PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings);
+
+    /// One Biot call over dt (M22).
+    BiotCallReport advance(Real dt, PfemTimings& timings);
+
+    /// Appends this solid's nodes (rest positions) and tets to `frame`, with the point arrays
+    /// displacement, pore_pressure, porosity (M23), permeability (M24, 6 components),
+    /// effective_stress (6), principal_stress (3) and crack_candidate (sigma'_1 / sigma_t, M25).
+    void append_to(MeshFrame& frame) const;
+
+    const TetMesh& mesh() const { return m_mesh; }
+    const BiotFields& fields() const { return m_fields; }
+
+private:
+    const PorousSolid& m_scene;
+    Real m_grain_bulk_modulus;  ///< K_s = K_dr / (1 - B), Pa
+    TetMesh m_mesh;
+    BiotSolver m_solver;
+    BiotFields m_fields;
+};
+
+}  // namespace karst

@@ -1,0 +1,109 @@
+// Poroelastic-only scenes (issue 4): porous solids with regions for boundary conditions, run by
+// the Biot solver alone. Terzaghi through the shipped scene, scene errors, and the output folder.
+#include "karst/pfem/poroelastic_solid.hpp"
+#include "karst/scene/scene_error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fmt/format.h>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace karst {
+namespace {
+
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+const std::string k_scene = std::string(KARST_SOURCE_DIR) + "/scenes/terzaghi_consolidation.json";
+
+/// Terzaghi's series (MOOSE terzaghi.i parameters: c_v = 13.95, p0 = 0.6977) for a column of
+/// height h: pressure at height z over the base.
+Real terzaghi_pressure(Real z, Real t, Real h) {
+    constexpr Real pi = std::numbers::pi, c_v = 1.5 / (0.0625 + 0.36 * 0.125), p0 = 0.6 * 0.125 / (0.0625 + 0.36 * 0.125);
+    Real p = 0;
+    for (int k = 0; k < 200; ++k) {
+        const Real n = 2 * k + 1;
+        p += (k % 2 ? -1 : 1) / n * std::cos(n * pi * z / (2 * h)) * std::exp(-n * n * pi * pi * c_v * t / (4 * h * h));
+    }
+    return 4 * p0 / pi * p;
+}
+
+TEST(PoroelasticScene, ShippedTerzaghiSceneConsolidatesLikeTheSeries) {
+    const Model model = build_model(load_scene_file(k_scene));
+    ASSERT_EQ(model.porous.size(), 1u);
+    PfemTimings timings;
+    PoroelasticSolid solid(model, model.porous[0], timings);
+    // The particles sit half a spacing inside the 10 m box: the mesh column is 9.75 m high.
+    const Real base = 0.125, h = 9.75, t_end = 1.4;
+    for (Real t = 0; t < t_end - 1e-12; t += model.scene.poroelastic.time_step) solid.advance(model.scene.poroelastic.time_step, timings);
+    Real err2 = 0, ref2 = 0;
+    for (Index a = 0; a < solid.mesh().node_count(); ++a) {
+        const Real exact = terzaghi_pressure(solid.mesh().nodes[a][2] - base, t_end, h);
+        err2 += std::pow(solid.fields().p[a] - exact, 2), ref2 += exact * exact;
+    }
+    EXPECT_LT(std::sqrt(err2 / ref2), 0.03) << "L2 error of the pore pressure over the column";
+    EXPECT_GT(timings.biot_calls, 0);
+}
+
+TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
+    const std::string valid = read_text(k_scene);
+    auto refuse = [](const std::string& text) {
+        try {
+            build_model(parse_scene(text));
+        } catch (const SceneError& e) {
+            return e;
+        }
+        ADD_FAILURE() << "accepted";
+        return SceneError("", "", "");
+    };
+    auto edit = [&](const std::string& from, const std::string& to) {
+        std::string s = valid;
+        const auto at = s.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        return s.replace(at, from.size(), to);
+    };
+    EXPECT_EQ(refuse(edit("\"poisson_ratio\"", "\"poison_ratio\"")).path, "/porous_solids/0/material/poison_ratio");
+    EXPECT_EQ(refuse(edit("\"kind\": \"drained\"", "\"kind\": \"drainde\"")).path, "/porous_solids/0/constraints/5/kind");
+    EXPECT_EQ(refuse(edit("\"biot_coefficient\": 0.6", "\"biot_coefficient\": 0.05")).path, "/porous_solids/0/material/biot_coefficient");
+    EXPECT_EQ(refuse(edit("\"axes\": \"x\"", "\"axes\": \"w\"")).path, "/porous_solids/0/constraints/0/axes");
+    EXPECT_EQ(refuse(edit("\"youngs_modulus\": 7.2", "\"youngs_modulus\": -7.2")).path, "/porous_solids/0/material/youngs_modulus");
+    // Fluid inside a porous solid.
+    const SceneError overlap = refuse(edit("\"porous_solids\": [",
+        "\"fluid_blocks\": [ { \"shape\": { \"type\": \"box\", \"min\": [0, 0, 0], \"max\": [1, 1, 1] } } ], \"porous_solids\": ["));
+    EXPECT_EQ(overlap.path, "/porous_solids/0/shape");
+    EXPECT_NE(overlap.found.find("/fluid_blocks/0"), std::string::npos);
+}
+
+TEST(PoroelasticScene, CliWritesMeshFramesListedInRunPvdAndStats) {
+    const std::filesystem::path out = std::filesystem::temp_directory_path() / "karst_test_poroelastic";
+    std::filesystem::remove_all(out);
+    const std::string command = std::string(KARST_BINARY) + " run " + k_scene + " --end-time 0.2 --fps 10 --quiet --out " + out.string();
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    for (int f = 0; f < 3; ++f) EXPECT_TRUE(std::filesystem::exists(out / fmt::format("mesh_{:04d}.vtu", f))) << f;
+    EXPECT_FALSE(std::filesystem::exists(out / "mesh_0003.vtu"));
+    const std::string pvd = read_text(out / "run.pvd");
+    for (int f = 0; f < 3; ++f) EXPECT_NE(pvd.find(fmt::format("part=\"2\" file=\"mesh_{:04d}.vtu\"", f)), std::string::npos);
+    const std::string vtu = read_text(out / "mesh_0002.vtu");
+    for (const char* array : {"displacement", "pore_pressure", "porosity", "permeability", "effective_stress", "principal_stress", "crack_candidate"})
+        EXPECT_NE(vtu.find(fmt::format("Name=\"{}\"", array)), std::string::npos) << array;
+    EXPECT_NE(vtu.find("Name=\"types\""), std::string::npos);
+    const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
+    EXPECT_EQ(stats["counts"]["porous"], 640);
+    EXPECT_GT(stats["counts"]["elements"].get<int>(), 1000);
+    EXPECT_EQ(stats["counts"]["fragments"], 1);
+    for (const char* phase : {"meshing", "assembly", "factorisation", "iterations"}) EXPECT_TRUE(stats["phases"].contains(phase)) << phase;
+    EXPECT_GT(stats["biot"]["iterations"].get<int>(), 0);
+    std::filesystem::remove_all(out);
+}
+
+}  // namespace
+}  // namespace karst
