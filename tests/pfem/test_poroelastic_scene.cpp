@@ -1,6 +1,7 @@
 // Poroelastic-only scenes (issue 4): porous solids with regions for boundary conditions, run by
 // the Biot solver alone. Terzaghi through the shipped scene, scene errors, and the output folder.
 #include "karst/pfem/poroelastic_solid.hpp"
+#include "karst/pfem/porosity.hpp"
 #include "karst/scene/scene_error.hpp"
 
 #include <gtest/gtest.h>
@@ -52,6 +53,32 @@ TEST(PoroelasticScene, ShippedTerzaghiSceneConsolidatesLikeTheSeries) {
     }
     EXPECT_LT(std::sqrt(err2 / ref2), 0.03) << "L2 error of the pore pressure over the column";
     EXPECT_GT(timings.biot_calls, 0);
+}
+
+TEST(PoroelasticScene, CompactionLowersPermeabilityByKozenyCarman) {
+    // A drained, laterally confined block pressed from the top by 0.1 MPa: uniform strain
+    // eps_zz = -q / (lambda + 2 mu), so M23 and M24 give one permeability for every tet.
+    const Model model = build_model(parse_scene(R"({
+      "name": "compaction", "particle_spacing": 0.25, "gravity": [0, 0, 0],
+      "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [1, 1, 1] },
+        "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "poisson_ratio": 0.25, "biot_coefficient": 0.9 },
+        "constraints": [
+          { "kind": "fixed", "axes": "x", "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+          { "kind": "fixed", "axes": "x", "region": { "type": "box", "min": [1, -1, -1], "max": [2, 2, 2] } },
+          { "kind": "fixed", "axes": "y", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 0, 2] } },
+          { "kind": "fixed", "axes": "y", "region": { "type": "box", "min": [-1, 1, -1], "max": [2, 2, 2] } },
+          { "kind": "fixed", "axes": "z", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 0] } },
+          { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
+          { "kind": "traction", "traction": [0, 0, -1e5], "region": { "type": "box", "min": [-1, -1, 1], "max": [2, 2, 2] } } ] } ]
+    })"));
+    PfemTimings timings;
+    PoroelasticSolid solid(model, model.porous[0], timings);
+    solid.advance(1.0, timings);
+    const BiotMaterial& m = solid.problem().material;
+    const Real eps_v = -1e5 / (m.lame_lambda() + 2 * m.shear_modulus());
+    const Real k = kozeny_carman_permeability(1e-10, 0.3, dynamic_porosity(0.3, eps_v, 0, 1e30));
+    ASSERT_LT(k, 0.9e-10) << "a 10 % compaction must close pores";
+    for (const Mat3& mobility : solid.problem().mobility) ASSERT_NEAR(mobility(0, 0) * 0.1 / k, 1, 1e-6);  // eta = 0.1
 }
 
 TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {

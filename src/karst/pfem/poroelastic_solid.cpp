@@ -58,6 +58,13 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
             else p.drained[a] = 1, p.drained_pressure[a] = c.pressure;
         }
     }
+    // Nodes touching a static wall (within a spacing of its particle skin) are anchored, u = 0
+    // (method.md §5.3): a block resting on the ground is held by it.
+    for (const Wall& w : model.scene.walls)
+        for (Index a = 0; a < n; ++a) {
+            const Real d = w.shape.signed_distance(mesh.nodes[a]);
+            if (w.kind == Wall::Kind::Obstacle ? d <= model.dx : d >= -model.dx) p.fixed[a] = FixAll;
+        }
     p.free_body = std::all_of(p.fixed.begin(), p.fixed.end(), [](std::uint8_t f) { return f == 0; });
     return p;
 }
@@ -77,6 +84,7 @@ BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh
 
 PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings)
     : m_scene(model.scene.porous_solids[body.solid]),
+      m_feedback(model.scene.poroelastic.permeability_feedback),
       m_mesh(mesh_body(model, body, timings)),
       m_solver(make_solver(model, body, m_mesh, timings)),
       m_fields{std::vector<Vec3>(m_mesh.node_count(), Vec3::Zero()), std::vector<Real>(m_mesh.node_count(), 0)} {
@@ -84,6 +92,7 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
     m_grain_bulk_modulus = b.biot_coefficient < 1 ? b.drained_bulk_modulus() / (1 - b.biot_coefficient) : std::numeric_limits<Real>::infinity();
     for (Index a = 0; a < m_mesh.node_count(); ++a)
         if (m_solver.problem().drained[a]) m_fields.p[a] = m_solver.problem().drained_pressure[a];
+    m_assembled_k.assign(m_mesh.tet_count(), m_scene.material.permeability);
 }
 
 BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {
@@ -93,7 +102,32 @@ BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {
     ++timings.biot_calls;
     timings.biot_iterations += r.iterations;
     timings.all_converged = timings.all_converged && r.converged;
+    if (m_feedback) refresh_permeability();
     return r;
+}
+
+void PoroelasticSolid::refresh_permeability() {
+    // Feedback (method.md §5.4): M23 porosity and M24 permeability at the nodes, averaged over
+    // each tet's nodes, give the mobility of the next call. H is reassembled (and the flow matrix
+    // refactorised) only when some tet's permeability moved by over 1 % since the last assembly.
+    const NodalStress stress = nodal_stress(m_mesh, m_solver.problem().material, m_fields);
+    const PorousMaterial& mat = m_scene.material;
+    std::vector<Real> k(m_mesh.node_count());
+    for (Index a = 0; a < m_mesh.node_count(); ++a)
+        k[a] = kozeny_carman_permeability(mat.permeability, mat.porosity,
+                                          dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus));
+    std::vector<Real> tet_k(m_mesh.tet_count());
+    bool changed = false;
+    for (Index e = 0; e < m_mesh.tet_count(); ++e) {
+        const Tet& t = m_mesh.tets[e];
+        tet_k[e] = 0.25 * (k[t[0]] + k[t[1]] + k[t[2]] + k[t[3]]);
+        changed = changed || std::abs(tet_k[e] / m_assembled_k[e] - 1) > 0.01;
+    }
+    if (!changed) return;
+    std::vector<Mat3> mobility(m_mesh.tet_count());
+    for (Index e = 0; e < m_mesh.tet_count(); ++e) mobility[e] = (tet_k[e] / mat.darcy_viscosity) * Mat3::Identity();
+    m_solver.set_mobility(std::move(mobility));
+    m_assembled_k = std::move(tet_k);
 }
 
 void PoroelasticSolid::append_to(MeshFrame& frame) const {

@@ -19,7 +19,7 @@ public:
     /// Meshes the body and assembles its Biot problem (factorising the elasticity matrix).
     PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings);
 
-    /// One Biot call over dt (M22).
+    /// One Biot call over dt (M22), then the porosity/permeability feedback (§5.4).
     BiotCallReport advance(Real dt, PfemTimings& timings);
 
     /// Appends this solid's nodes (rest positions) and tets to `frame`, with the point arrays
@@ -29,13 +29,18 @@ public:
 
     const TetMesh& mesh() const { return m_mesh; }
     const BiotFields& fields() const { return m_fields; }
+    const BiotProblem& problem() const { return m_solver.problem(); }
 
 private:
+    void refresh_permeability();
+
     const PorousSolid& m_scene;
+    bool m_feedback;
     Real m_grain_bulk_modulus;  ///< K_s = K_dr / (1 - B), Pa
     TetMesh m_mesh;
     BiotSolver m_solver;
     BiotFields m_fields;
+    std::vector<Real> m_assembled_k;  ///< per tet: the permeability H was assembled with, m^2
 };
 
 }  // namespace karst

@@ -125,6 +125,7 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
     s.poroelastic.weighted_alpha = pe["weighted_alpha"];
+    s.poroelastic.permeability_feedback = pe["permeability_feedback"];
     s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"], s.output.ply = doc["output"]["ply"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];

@@ -80,6 +80,7 @@ struct PoroelasticSettings {
     bool fixed_strain = false;       ///< the paper's splitting instead of fixed-stress
     int max_iterations = 5;
     Real tolerance = 1e-3;
+    bool permeability_feedback = true;  ///< §5.4 after every call
     Real alpha = 1.25;               ///< M19
     Real join_delta = 0.1;           ///< M20
     bool weighted_alpha = false;

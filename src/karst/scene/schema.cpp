@@ -142,6 +142,9 @@ std::vector<KeySpec> make_schema() {
         key("/poroelastic/max_iterations", T::Integer, "", closed(1, 1000), 5, "k_max of M22."),
         key("/poroelastic/tolerance", T::Number, "", closed(1e-14, 1), 1e-3,
             "Relative change of p and u that ends the iterations (M22)."),
+        key("/poroelastic/permeability_feedback", T::Bool, "", any(), true,
+            "Update porosity (M23) and permeability (M24) from the strain and pressure after every "
+            "Biot call; false keeps k = k0, as linear poroelasticity benchmarks assume."),
         key("/poroelastic/alpha", T::Number, "", closed(0.6, 10), 1.25, "Alpha-shape factor (M19)."),
         key("/poroelastic/join_delta", T::Number, "", closed(0, 1), 0.1, "EDT joining factor delta (M20)."),
         key("/poroelastic/weighted_alpha", T::Bool, "", any(), false,
