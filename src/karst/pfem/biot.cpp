@@ -14,6 +14,7 @@
 #include "karst/core/check.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/pfem/p1_tet.hpp"
+#include "karst/pfem/polyhedral_elements.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
@@ -113,6 +114,7 @@ struct BiotSolver::Impl {
     BiotOptions options;
     Index n = 0;
     std::vector<P1Tet> elements;
+    std::vector<PolyhedralElement> polyhedra;  // M21 option only
 
     SparseMatrix K, Q, H;           // full matrices (3n x 3n, 3n x n, n x n)
     SparseMatrix mass;              // consistent P1 mass (n x n) of the fixed-stress term
@@ -139,7 +141,14 @@ struct BiotSolver::Impl {
         Stopwatch watch;
         elements.resize(mesh.tet_count());
         for (Index e = 0; e < mesh.tet_count(); ++e) elements[e] = p1_tet(mesh, e);
-        assemble_mechanics();
+        if (options.polyhedral) {
+            Real spacing = 0;  // gradient step 1e-4 of the mean edge length (M21: 1e-4 dx)
+            for (const Tet& t : mesh.tets) spacing += (mesh.nodes[t[1]] - mesh.nodes[t[0]]).norm();
+            polyhedra = polyhedral_elements(mesh, 1e-4 * spacing / std::max<Index>(1, mesh.tet_count()));
+            assemble_polyhedral_mechanics();
+        } else {
+            assemble_mechanics();
+        }
         assemble_flow();
         set_up_boundary();
         t_assembly = watch.seconds();
@@ -190,12 +199,75 @@ struct BiotSolver::Impl {
         storage = problem.material.storage * lumped_volume;
     }
 
+    /// M21 elements: K_e = sum_q w B^T D B, Q_e[3a+c, b] = sum_q w B (dN_a/dx_c) N_b, lumped
+    /// volume and body force sum_q w N_a. The fixed-stress term uses the lumped volume here.
+    void assemble_polyhedral_mechanics() {
+        const BiotMaterial& m = problem.material;
+        const auto D = elasticity_matrix(m);
+        Triplets k_entries, q_entries;
+        lumped_volume = Vector::Zero(n);
+        f_ext = Vector::Zero(3 * n);
+        for (const PolyhedralElement& element : polyhedra) {
+            const int size = int(element.nodes.size());
+            Eigen::MatrixXd Ke = Eigen::MatrixXd::Zero(3 * size, 3 * size), Qe = Eigen::MatrixXd::Zero(3 * size, size);
+            Eigen::Matrix<Real, 6, Eigen::Dynamic> B(6, 3 * size);
+            for (const PolyhedralElement::Point& q : element.points) {
+                B.setZero();
+                for (int a = 0; a < size; ++a) {
+                    const Vec3& g = q.grad[a];
+                    const int c = 3 * a;
+                    B(0, c) = g[0], B(1, c + 1) = g[1], B(2, c + 2) = g[2];
+                    B(3, c + 1) = g[2], B(3, c + 2) = g[1];
+                    B(4, c) = g[2], B(4, c + 2) = g[0];
+                    B(5, c) = g[1], B(5, c + 1) = g[0];
+                    lumped_volume[element.nodes[a]] += q.weight * q.N[a];
+                    f_ext.segment<3>(3 * element.nodes[a]) += m.bulk_density * problem.gravity * (q.weight * q.N[a]);
+                    for (int b = 0; b < size; ++b)
+                        for (int d = 0; d < 3; ++d) Qe(3 * a + d, b) += q.weight * m.biot_coefficient * g[d] * q.N[b];
+                }
+                Ke += q.weight * B.transpose() * D * B;
+            }
+            for (int a = 0; a < size; ++a)
+                for (int c = 0; c < 3; ++c) {
+                    const int row = int(3 * element.nodes[a] + c);
+                    for (int b = 0; b < size; ++b) {
+                        for (int d = 0; d < 3; ++d) k_entries.emplace_back(row, int(3 * element.nodes[b] + d), Ke(3 * a + c, 3 * b + d));
+                        q_entries.emplace_back(row, int(element.nodes[b]), Qe(3 * a + c, b));
+                    }
+                }
+        }
+        K.resize(3 * n, 3 * n);
+        K.setFromTriplets(k_entries.begin(), k_entries.end());
+        Q.resize(3 * n, n);
+        Q.setFromTriplets(q_entries.begin(), q_entries.end());
+        mass.resize(n, n);
+        for (Index a = 0; a < n; ++a) mass.insert(a, a) = lumped_volume[a];
+        if (problem.free_body)
+            for (int i = 0; i < 3 * n; ++i) K.coeffRef(i, i) *= 1 + problem.rigid_mode_spring;
+        for (Index a = 0; a < Index(problem.nodal_force.size()); ++a) f_ext.segment<3>(3 * a) += problem.nodal_force[a];
+        storage = problem.material.storage * lumped_volume;
+    }
+
+    void assemble_polyhedral_flow(Triplets& h_entries, const Vec3& rho_g) {
+        for (const PolyhedralElement& element : polyhedra)
+            for (const PolyhedralElement::Point& q : element.points) {
+                const Mat3& mobility = problem.mobility[q.tet];
+                for (size_t a = 0; a < element.nodes.size(); ++a) {
+                    const Vec3 flux_a = mobility * q.grad[a];
+                    for (size_t b = 0; b < element.nodes.size(); ++b)
+                        h_entries.emplace_back(int(element.nodes[a]), int(element.nodes[b]), q.weight * flux_a.dot(q.grad[b]));
+                    gravity_flux[element.nodes[a]] += q.weight * flux_a.dot(rho_g);
+                }
+            }
+    }
+
     void assemble_flow() {
         Triplets h_entries;
         h_entries.reserve(size_t(mesh.tet_count()) * 16);
         gravity_flux = Vector::Zero(n);
         const Vec3 rho_g = problem.material.fluid_density * problem.gravity;
-        for (Index e = 0; e < mesh.tet_count(); ++e) {
+        if (options.polyhedral) assemble_polyhedral_flow(h_entries, rho_g);
+        for (Index e = 0; e < mesh.tet_count() && !options.polyhedral; ++e) {
             const P1Tet& p = elements[e];
             const Tet& t = mesh.tets[e];
             const Mat3& mobility = problem.mobility[e];

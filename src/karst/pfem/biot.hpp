@@ -49,6 +49,8 @@ struct BiotOptions {
     Splitting splitting = Splitting::FixedStress;
     int max_iterations = 5;   ///< M22: k_max
     Real tolerance = 1e-3;    ///< M22 stopping test on relative changes of p and u
+    /// M21: EDT polyhedra with Laplace shape functions instead of P1 tets (method.md §5.2).
+    bool polyhedral = false;
 };
 
 struct BiotFields {

@@ -74,6 +74,7 @@ BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh
     BiotOptions options;
     options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
     options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
+    options.polyhedral = pe.mfem_polyhedra;
     BiotSolver solver(mesh, biot_problem(model, model.scene.porous_solids[body.solid], mesh), options);
     timings.assembly += solver.seconds_assembly();
     timings.factorisation += solver.seconds_elastic_factorisation();

@@ -122,6 +122,7 @@ Scene parse_scene(const std::string& text) {
     const json& pe = doc["poroelastic"];
     s.poroelastic.time_step = pe["time_step"], s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
     s.poroelastic.fixed_strain = pe["splitting"] == "fixed_strain";
+    s.poroelastic.mfem_polyhedra = pe["shape_functions"] == "mfem_polyhedra";
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
     s.poroelastic.weighted_alpha = pe["weighted_alpha"];

@@ -78,6 +78,7 @@ struct PoroelasticSettings {
     Real time_step = 1.0 / 30;       ///< dt_B, s
     Real fluid_bulk_modulus = 1e5;   ///< K_f, Pa
     bool fixed_strain = false;       ///< the paper's splitting instead of fixed-stress
+    bool mfem_polyhedra = false;     ///< M21 shape functions instead of P1
     int max_iterations = 5;
     Real tolerance = 1e-3;
     bool permeability_feedback = true;  ///< §5.4 after every call

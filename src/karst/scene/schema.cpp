@@ -139,6 +139,11 @@ std::vector<KeySpec> make_schema() {
             "fixed_stress (M22, L = B^2/K_dr) or fixed_strain (the paper's order, L = 0; diverges "
             "when tau = B^2 M/K_dr > 1).",
             {"fixed_stress", "fixed_strain"}),
+        key("/poroelastic/shape_functions", T::Enum, "", any(), "p1",
+            "p1: linear tets (method.md §5.2 default); mfem_polyhedra: EDT polyhedra with Laplace "
+            "shape functions (M21), slower to assemble but free of the tets' shear locking (a "
+            "cantilever: 0.4 % off Timoshenko against 5 % with p1 at the same nodes).",
+            {"p1", "mfem_polyhedra"}),
         key("/poroelastic/max_iterations", T::Integer, "", closed(1, 1000), 5, "k_max of M22."),
         key("/poroelastic/tolerance", T::Number, "", closed(1e-14, 1), 1e-3,
             "Relative change of p and u that ends the iterations (M22)."),
