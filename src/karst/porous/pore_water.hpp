@@ -1,0 +1,56 @@
+#pragma once
+// The pore-water state of porous particles and its constitutive laws (method.md §2, M3-M6).
+#include "karst/core/types.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace karst {
+
+/// Porous particles as structure-of-arrays (the pore side; fragments come with issue 3's rigid
+/// bodies). Mass of pore water m_p is the conserved quantity.
+struct PorousParticles {
+    std::vector<Vec3> x;               ///< world position, m
+    std::vector<Real> volume;          ///< bulk volume V, m^3
+    std::vector<Real> porosity;        ///< phi
+    std::vector<Real> absorbed_mass;   ///< m_p, kg
+    std::vector<Mat3> permeability;    ///< world tensor K (M12), m^2
+    std::vector<Index> fragment;       ///< pairs in different fragments exchange only in contact
+    Index size() const { return Index(x.size()); }
+};
+
+/// Below this porosity a particle is impermeable (M3) and takes part in no transfer.
+inline constexpr Real k_min_porosity = 1e-4;
+
+/// Material constants of the pore water (method.md §8.2 defaults).
+struct PoreWaterLaw {
+    Real rest_density = 1000;      ///< rho0, kg/m^3
+    Real capillary_scale = 2000;   ///< k^c, Pa
+    Real capillary_exponent = 0.5; ///< alpha of M4, (0, 1]
+    Real pore_stiffness = 1.4e4;   ///< k^p, Pa
+    Real tait_exponent = 7;        ///< gamma of M5
+    Real saturation_exponent = 2;  ///< beta: k_r = S^beta
+    Real darcy_viscosity = 0.1;    ///< eta, Pa s
+    Vec3 gravity{0, 0, -9.81};     ///< m/s^2
+
+    /// M3: S = m_p / (rho0 phi V).
+    Real saturation(Real m_p, Real phi, Real V) const { return m_p / (rest_density * phi * V); }
+    /// M4: P^c = k^c (1 - min(S, 1))^alpha.
+    Real capillary_potential(Real S) const { return capillary_scale * std::pow(1 - std::min(S, Real(1)), capillary_exponent); }
+    /// M5: P^p = k^p S max(0, S^gamma - 1).
+    Real pore_pressure(Real S) const { return pore_stiffness * S * std::max(Real(0), std::pow(S, tait_exponent) - 1); }
+    /// M6: Phi = P^p - P^c - rho0 g.x.
+    Real flow_potential(Real S, const Vec3& x) const {
+        return pore_pressure(S) - capillary_potential(S) - rest_density * gravity.dot(x);
+    }
+    /// dPhi/dS (for the sub-step limit, §4.7.5), with dP^c/dS taken at max(1 - S, 0.01).
+    Real potential_slope(Real S) const {
+        const Real dry = std::max(1 - S, Real(0.01));
+        const Real capillary = capillary_scale * capillary_exponent * std::pow(dry, capillary_exponent - 1);
+        const Real pore = S > 1 ? pore_stiffness * ((tait_exponent + 1) * std::pow(S, tait_exponent) - 1) : 0;
+        return pore + capillary;
+    }
+};
+
+}  // namespace karst
