@@ -21,6 +21,19 @@ struct Block {
     NeighbourLists neighbours;
 };
 
+/// Lists every particle's neighbours within the longest kernel reach (M13).
+void find_pairs(Block& b) {
+    const PorousParticles& p = b.particles;
+    Real reach = 0;
+    for (const Mat3& K : p.permeability) reach = std::max(reach, kernel_reach(K, k_h));
+    Aabb box;
+    for (const Vec3& x : p.x) box.extend(x);
+    const UniformGrid grid(box.padded(reach), reach);
+    CellRanges cells;
+    sort_into_cells(grid, p.x, cells);
+    find_neighbours(grid, p.x, cells, true, b.neighbours);
+}
+
 /// An n^3 lattice block centred at the origin, turned by `rotation` (positions and tensor: M12).
 Block lattice_block(int n, const Mat3& rotation, const Mat3& body_tensor) {
     Block b;
@@ -36,13 +49,7 @@ Block lattice_block(int n, const Mat3& rotation, const Mat3& body_tensor) {
                 p.permeability.push_back(world_permeability(k_k0, k_k0, rotation, body_tensor));
                 p.fragment.push_back(0);
             }
-    const Real reach = kernel_reach(p.permeability[0], k_h);
-    Aabb box;
-    for (const Vec3& x : p.x) box.extend(x);
-    const UniformGrid grid(box.padded(reach), reach);
-    CellRanges cells;
-    sort_into_cells(grid, p.x, cells);
-    find_neighbours(grid, p.x, cells, true, b.neighbours);
+    find_pairs(b);
     return b;
 }
 
@@ -154,12 +161,7 @@ Block column(int nx, int nz, Real permeability = k_k0) {
                 p.volume.push_back(k_dx * k_dx * k_dx), p.porosity.push_back(k_phi), p.absorbed_mass.push_back(0);
                 p.permeability.push_back(permeability * Mat3::Identity()), p.fragment.push_back(0);
             }
-    Aabb box;
-    for (const Vec3& x : p.x) box.extend(x);
-    const UniformGrid grid(box.padded(k_h), k_h);
-    CellRanges cells;
-    sort_into_cells(grid, p.x, cells);
-    find_neighbours(grid, p.x, cells, true, b.neighbours);
+    find_pairs(b);
     return b;
 }
 

@@ -36,17 +36,21 @@ Eigen::Matrix<Real, 6, 6> elasticity_matrix(const BiotMaterial& m) {
     return D;
 }
 
+/// Writes node a's three columns of the strain-displacement matrix B_u (Voigt order, engineering
+/// shear) for the shape-function gradient g.
+template <class Matrix>
+void set_strain_displacement_columns(Matrix& B, int a, const Vec3& g) {
+    const int c = 3 * a;
+    B(0, c) = g[0], B(1, c + 1) = g[1], B(2, c + 2) = g[2];
+    B(3, c + 1) = g[2], B(3, c + 2) = g[1];
+    B(4, c) = g[2], B(4, c + 2) = g[0];
+    B(5, c) = g[1], B(5, c + 1) = g[0];
+}
+
 /// Strain-displacement matrix B_u (6 x 12) of a P1 tet.
 Eigen::Matrix<Real, 6, 12> strain_displacement(const P1Tet& p) {
     Eigen::Matrix<Real, 6, 12> B = Eigen::Matrix<Real, 6, 12>::Zero();
-    for (int a = 0; a < 4; ++a) {
-        const Vec3& g = p.grad[a];
-        const int c = 3 * a;
-        B(0, c) = g[0], B(1, c + 1) = g[1], B(2, c + 2) = g[2];
-        B(3, c + 1) = g[2], B(3, c + 2) = g[1];
-        B(4, c) = g[2], B(4, c + 2) = g[0];
-        B(5, c) = g[1], B(5, c + 1) = g[0];
-    }
+    for (int a = 0; a < 4; ++a) set_strain_displacement_columns(B, a, p.grad[a]);
     return B;
 }
 
@@ -215,11 +219,7 @@ struct BiotSolver::Impl {
                 B.setZero();
                 for (int a = 0; a < size; ++a) {
                     const Vec3& g = q.grad[a];
-                    const int c = 3 * a;
-                    B(0, c) = g[0], B(1, c + 1) = g[1], B(2, c + 2) = g[2];
-                    B(3, c + 1) = g[2], B(3, c + 2) = g[1];
-                    B(4, c) = g[2], B(4, c + 2) = g[0];
-                    B(5, c) = g[1], B(5, c + 1) = g[0];
+                    set_strain_displacement_columns(B, a, g);
                     lumped_volume[element.nodes[a]] += q.weight * q.N[a];
                     f_ext.segment<3>(3 * element.nodes[a]) += m.bulk_density * problem.gravity * (q.weight * q.N[a]);
                     for (int b = 0; b < size; ++b)
