@@ -24,36 +24,33 @@ void parallel_for(Index n, const Body& body) {
                       });
 }
 
-/// Maximum of f(i) over [0, n) (order-independent, so deterministic), `init` when n == 0.
-template <class F>
-Real parallel_max(Index n, Real init, const F& f) {
+/// Folds f(i) over [0, n) with `combine` in fixed blocks combined in block order: the same bits
+/// on any thread count, for any combine (associative or, like floating-point +, not).
+template <class T, class F, class Combine>
+T deterministic_reduce(Index n, T identity, const F& f, const Combine& combine) {
     constexpr Index block = 4096;
     const Index blocks = (n + block - 1) / block;
-    std::vector<Real> partial(static_cast<size_t>(blocks), init);
+    std::vector<T> partial(static_cast<size_t>(blocks), identity);
     parallel_for(blocks, [&](Index b) {
-        Real m = init;
-        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) m = std::max(m, f(i));
-        partial[b] = m;
+        T acc = identity;
+        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) acc = combine(acc, f(i));
+        partial[b] = acc;
     });
-    Real m = init;
-    for (Real p : partial) m = std::max(m, p);
-    return m;
+    T acc = identity;
+    for (const T& p : partial) acc = combine(acc, p);
+    return acc;
 }
 
-/// Sum of f(i) over [0, n) in fixed blocks added in block order: the same bits on any thread count.
+/// Maximum of f(i) over [0, n), `init` when n == 0.
+template <class F>
+Real parallel_max(Index n, Real init, const F& f) {
+    return deterministic_reduce(n, init, f, [](Real a, Real b) { return std::max(a, b); });
+}
+
+/// Sum of f(i) over [0, n), deterministic.
 template <class T, class F>
 T deterministic_sum(Index n, T zero, const F& f) {
-    constexpr Index block = 4096;
-    const Index blocks = (n + block - 1) / block;
-    std::vector<T> partial(static_cast<size_t>(blocks), zero);
-    parallel_for(blocks, [&](Index b) {
-        T s = zero;
-        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) s += f(i);
-        partial[b] = s;
-    });
-    T s = zero;
-    for (const T& p : partial) s += p;
-    return s;
+    return deterministic_reduce(n, zero, f, [](const T& a, const T& b) { return T(a + b); });
 }
 
 /// Limits the threads karst uses for as long as it lives (0 = all cores).
