@@ -38,6 +38,9 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         points.add_vector("velocity", fluid.v);
         points.add_scalar("density", fluid.rho);
         points.add_scalar("pressure", fluid.p);
+        std::vector<Real> concentration(fluid.size());
+        for (Index i = 0; i < fluid.size(); ++i) concentration[i] = fluid.solute[i] / fluid.mass[i];
+        points.add_scalar("concentration", concentration);
         points.add_integer("id", fluid.id);
         if (m_settings.vtp) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame), vtp_bytes(points));
         if (m_settings.ply) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));

@@ -72,6 +72,7 @@ Scene parse_scene(const std::string& text) {
     s.fluid.rest_density = f["rest_density"], s.fluid.viscosity = f["viscosity"];
     s.fluid.surface_tension = f["surface_tension"], s.fluid.adhesion = f["adhesion"];
     s.fluid.wall_friction = f["wall_friction"], s.fluid.sound_speed = f["sound_speed"];
+    s.fluid.solute_diffusivity = f["solute_diffusivity"];
     s.fluid.max_density_error = f["max_density_error"];
     s.fluid.min_iterations = f["min_iterations"], s.fluid.max_iterations = f["max_iterations"];
     if (s.fluid.min_iterations > s.fluid.max_iterations)
@@ -81,7 +82,7 @@ Scene parse_scene(const std::string& text) {
     for (size_t i = 0; i < doc["fluid_blocks"].size(); ++i) {
         const json& b = doc["fluid_blocks"][i];
         const std::string path = fmt::format("/fluid_blocks/{}", i);
-        s.fluid_blocks.push_back({read_shape(b["shape"], path + "/shape"), vec3(b["velocity"]), path});
+        s.fluid_blocks.push_back({read_shape(b["shape"], path + "/shape"), vec3(b["velocity"]), path, b["concentration"].get<Real>()});
     }
     for (size_t i = 0; i < doc["walls"].size(); ++i) {
         const json& w = doc["walls"][i];

@@ -26,6 +26,7 @@ struct FluidSettings {
     Real adhesion = 0;              ///< beta_adh
     Real wall_friction = 0;         ///< sigma_f
     Real sound_speed = 20;          ///< c_s, m/s
+    Real solute_diffusivity = 1e-4; ///< D of M18, m^2/s
     Real max_density_error = 0.01;  ///< eta_rho
     int min_iterations = 3;
     int max_iterations = 50;
@@ -35,6 +36,7 @@ struct FluidBlock {
     Shape shape;
     Vec3 velocity = Vec3::Zero();  ///< m/s
     std::string path;              ///< JSON pointer, for error messages
+    Real concentration = 0;        ///< initial C = m_sol / m
 };
 
 struct Wall {

@@ -69,6 +69,8 @@ std::vector<KeySpec> make_schema() {
             "Akinci 2012 fluid-wall friction coefficient sigma_f; 0 gives free slip."),
         key("/fluid/sound_speed", T::Number, "m/s", positive(1e4), 20.0,
             "Numerical sound speed c_s used by wall friction (about 10x the expected speed)."),
+        key("/fluid/solute_diffusivity", T::Number, "m^2/s", closed(0, 1), 1e-4,
+            "Diffusivity D of the solute among fluid particles (M18; scene-scaled, method.md §8.2)."),
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
             "PCISPH stops when the maximum clamped density error is below this fraction of rho0."),
         key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
@@ -81,6 +83,8 @@ std::vector<KeySpec> make_schema() {
         required("/fluid_blocks/[]/shape", T::Shape, "", any(), "Geometry of the block."),
         key("/fluid_blocks/[]/velocity", T::Vec3, "m/s", closed(-1000, 1000), zero3,
             "Initial velocity."),
+        key("/fluid_blocks/[]/concentration", T::Number, "", closed(0, 1), 0.0,
+            "Initial solute concentration C = m_sol / m (muddy water), method.md §4.9."),
 
         key("/walls", T::ObjectArray, "", any(), json::array(),
             "Static walls sampled as Akinci 2012 boundary particles."),

@@ -64,7 +64,9 @@ void sample_fluid_and_solids(const Scene& s, Model& m) {
         }
     };
     for (const FluidBlock& block : s.fluid_blocks)
-        sample(block.shape, block.path, [&](const Vec3& x) { m.initial_x.push_back(x), m.initial_v.push_back(block.velocity); });
+        sample(block.shape, block.path, [&](const Vec3& x) {
+            m.initial_x.push_back(x), m.initial_v.push_back(block.velocity), m.initial_concentration.push_back(block.concentration);
+        });
     // Porous solids sit on the exact lattice: jitter would give the mesh interior slivers
     // (pfem/box_nodes.hpp says why).
     for (size_t i = 0; i < s.porous_solids.size(); ++i) {

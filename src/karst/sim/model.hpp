@@ -41,6 +41,7 @@ struct Model {
     WallParticles walls;
     std::vector<Vec3> initial_x;  ///< fluid particles at t = 0, m
     std::vector<Vec3> initial_v;  ///< m/s
+    std::vector<Real> initial_concentration;  ///< C = m_sol / m
     std::vector<PorousBody> porous;
 
     /// M8: delta = rho0^2 / (2 dt^2 m^2 (|sum grad W|^2 + sum |grad W|^2)), in Pa per kg/m^3.

@@ -24,6 +24,9 @@ namespace {
 Real total_mass(const FluidParticles& f) {
     return deterministic_sum(f.size(), Real(0), [&](Index i) { return f.mass[i]; });
 }
+Real total_solute(const FluidParticles& f) {
+    return deterministic_sum(f.size(), Real(0), [&](Index i) { return f.solute[i]; });
+}
 
 /// Step length that reaches `target` in a whole number of steps no longer than dt_cfl, so
 /// frames land on their exact times without a sliver step.
@@ -67,7 +70,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     update_density(model, state);
     out.write_frame({&state.fluid}, {0, 0, 0, state.fluid.size(), 0, 0});
 
-    const Real water_initial = total_mass(state.fluid);
+    const Real water_initial = total_mass(state.fluid), solute_initial = total_solute(state.fluid);
     StepProfile profile;
     ProgressLine progress(opt.quiet);
     Real max_density_error = 0, frame_density_error = 0;
@@ -91,7 +94,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             {"sim_time", state.time},
             {"wall_time", wall.seconds()},
             {"phases", phases},
-            {"mass", {{"water_initial", water_initial}, {"water_final", total_mass(state.fluid)}}},
+            {"mass", {{"water_initial", water_initial}, {"water_final", total_mass(state.fluid)},
+                      {"solute_initial", solute_initial}, {"solute_final", total_solute(state.fluid)}}},
             {"max_density_error", max_density_error},
             {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
             {"threads", ThreadLimit::active_threads()},

@@ -77,7 +77,7 @@ RunResult run_poroelastic(const Model& model, const RunOptions& options) {
                   {"all_converged", timings.all_converged}}},
         {"mesh", {{"kept", quality.kept}, {"polyhedra", quality.polyhedra}, {"slivers_dropped", quality.slivers_dropped},
                   {"interior_slivers", quality.interior_slivers}}},
-        {"mass", {{"water_initial", 0.0}, {"water_final", 0.0}}},
+        {"mass", {{"water_initial", 0.0}, {"water_final", 0.0}, {"solute_initial", 0.0}, {"solute_final", 0.0}}},
         {"max_density_error", 0.0},
         {"mipps", node_steps / std::max(stepping.seconds(), 1e-9) / 1e6},  // node-steps of the Biot solver
         {"threads", ThreadLimit::active_threads()},

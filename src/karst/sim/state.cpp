@@ -15,12 +15,12 @@ void keep_flagged(std::vector<T>& a, const std::vector<char>& flag) {
 }  // namespace
 
 void FluidParticles::keep(const std::vector<char>& flag) {
-    keep_flagged(x, flag), keep_flagged(v, flag), keep_flagged(mass, flag);
+    keep_flagged(x, flag), keep_flagged(v, flag), keep_flagged(mass, flag), keep_flagged(solute, flag);
     keep_flagged(rho, flag), keep_flagged(p, flag), keep_flagged(id, flag);
 }
 
 void FluidParticles::permute(const std::vector<std::uint32_t>& perm) {
-    apply_permutation(x, perm), apply_permutation(v, perm), apply_permutation(mass, perm);
+    apply_permutation(x, perm), apply_permutation(v, perm), apply_permutation(mass, perm), apply_permutation(solute, perm);
     apply_permutation(rho, perm), apply_permutation(p, perm), apply_permutation(id, perm);
 }
 
@@ -30,6 +30,8 @@ State make_initial_state(const Model& model) {
     s.fluid.x = model.initial_x;
     s.fluid.v = model.initial_v;
     s.fluid.mass.assign(n, model.particle_mass);
+    s.fluid.solute.resize(n);
+    for (size_t i = 0; i < n; ++i) s.fluid.solute[i] = model.initial_concentration[i] * model.particle_mass;
     s.fluid.rho.assign(n, model.rho0);
     s.fluid.p.assign(n, 0);
     s.fluid.id.resize(n);

@@ -15,6 +15,7 @@ struct FluidParticles {
     std::vector<Vec3> x;          ///< (n) position, m
     std::vector<Vec3> v;          ///< (n) velocity, m/s
     std::vector<Real> mass;       ///< (n) kg
+    std::vector<Real> solute;     ///< (n) solute mass m_sol, kg; concentration C = m_sol / m
     std::vector<Real> rho;        ///< (n) density of the last step (M7), kg/m^3
     std::vector<Real> p;          ///< (n) PCISPH pressure of the last step, Pa
     std::vector<std::int64_t> id; ///< (n) stable particle id (export only)

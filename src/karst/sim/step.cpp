@@ -9,6 +9,7 @@
 #include "karst/sph/integrate.hpp"
 #include "karst/sph/non_pressure_forces.hpp"
 #include "karst/sph/pcisph.hpp"
+#include "karst/sph/solute_diffusion.hpp"
 
 namespace karst {
 
@@ -37,6 +38,10 @@ StepReport step(const Model& model, State& state, Real dt, StepProfile& profile)
     // 2. Fluid densities with the wall contribution (M7).
     timed(profile, Stage::Density, [&] { update_density(model, state); });
     check_scalars(state.fluid.rho, id, Stage::Density, t, "density");
+
+    // 2b. Solute diffusion among fluid particles (M18), on this step's densities and lists.
+    timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });
+    check_scalars(state.fluid.solute, id, Stage::SoluteDiffusion, t, "solute mass");
 
     // 3. Gravity, viscosity, surface tension, adhesion, wall friction (§4.2).
     timed(profile, Stage::NonPressureForces, [&] { compute_non_pressure_forces(model, state); });
