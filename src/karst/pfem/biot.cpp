@@ -12,6 +12,7 @@
 #include "karst/pfem/biot.hpp"
 
 #include "karst/core/check.hpp"
+#include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/pfem/p1_tet.hpp"
 #include "karst/pfem/polyhedral_elements.hpp"
@@ -145,16 +146,19 @@ struct BiotSolver::Impl {
         Stopwatch watch;
         elements.resize(mesh.tet_count());
         for (Index e = 0; e < mesh.tet_count(); ++e) elements[e] = p1_tet(mesh, e);
+        split_dofs();
         if (options.polyhedral) {
             Real spacing = 0;  // gradient step 1e-4 of the mean edge length (M21: 1e-4 dx)
             for (const Tet& t : mesh.tets) spacing += (mesh.nodes[t[1]] - mesh.nodes[t[0]]).norm();
             polyhedra = polyhedral_elements(mesh, 1e-4 * spacing / std::max<Index>(1, mesh.tet_count()));
             assemble_polyhedral_mechanics();
+            std::tie(K_ff, K_fc) = u_dofs.split(K);
+            elastic_lift = K_fc * u_dofs.gather_prescribed(u_prescribed);
         } else {
-            assemble_mechanics();
+            assemble_p1_mechanics();
         }
+        mass_ff = p_dofs.split(mass).first;
         assemble_flow();
-        set_up_boundary();
         t_assembly = watch.seconds();
         Stopwatch factor_watch;
         KARST_CHECK(u_dofs.free_count > 0);
@@ -163,42 +167,99 @@ struct BiotSolver::Impl {
         t_elastic_factor = factor_watch.seconds();
     }
 
-    void assemble_mechanics() {
+    /// P1 mechanics straight into compressed columns, in parallel over nodes (each node owns its
+    /// three columns, so no two tasks write one entry): K_ff with the lift K_fc u_c, Q, the
+    /// consistent mass, the lumped volume and the body force. With isotropic elasticity the 3 x 3
+    /// block of nodes b, a in one tet is V [lambda g_b g_a^T + mu (g_a.g_b) I + mu g_a g_b^T].
+    /// Triplets and setFromTriplets took 3.6 s on 393,600 tets; this pattern is built once.
+    void assemble_p1_mechanics() {
         const BiotMaterial& m = problem.material;
-        const auto D = elasticity_matrix(m);
-        Triplets k_entries, q_entries, m_entries;
-        k_entries.reserve(size_t(mesh.tet_count()) * 144);
-        q_entries.reserve(size_t(mesh.tet_count()) * 48);
+        const Real lambda = m.lame_lambda(), mu = m.shear_modulus();
+        // Tets around each node, and each node's sorted neighbour nodes (itself included).
+        std::vector<Index> tet_start(n + 1, 0), tet_list(4 * mesh.tet_count());
+        for (const Tet& t : mesh.tets)
+            for (Index a : t) ++tet_start[a + 1];
+        for (Index a = 0; a < n; ++a) tet_start[a + 1] += tet_start[a];
+        {
+            std::vector<Index> fill(tet_start.begin(), tet_start.end() - 1);
+            for (Index e = 0; e < mesh.tet_count(); ++e)
+                for (Index a : mesh.tets[e]) tet_list[fill[a]++] = e;
+        }
+        std::vector<std::vector<Index>> neighbours(n);
+        parallel_for(n, [&](Index b) {
+            auto& nb = neighbours[b];
+            for (Index k = tet_start[b]; k < tet_start[b + 1]; ++k)
+                for (Index a : mesh.tets[tet_list[k]]) nb.push_back(a);
+            std::sort(nb.begin(), nb.end());
+            nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+        });
+        auto free_u = [&](Index a, int c) { return u_dofs.free_index[3 * a + c]; };
+
+        // Column pointers of K_ff (free dofs in order), Q (n columns of 3 rows per neighbour) and M.
+        const int nf = u_dofs.free_count;
+        std::vector<int> k_outer(nf + 1, 0), q_outer(n + 1, 0), m_outer(n + 1, 0);
+        for (Index b = 0; b < n; ++b) {
+            int free_rows = 0;
+            for (Index a : neighbours[b])
+                for (int c = 0; c < 3; ++c) free_rows += free_u(a, c) >= 0;
+            for (int d = 0; d < 3; ++d)
+                if (const int col = free_u(b, d); col >= 0) k_outer[col + 1] = free_rows;
+            q_outer[b + 1] = q_outer[b] + 3 * int(neighbours[b].size());
+            m_outer[b + 1] = m_outer[b] + int(neighbours[b].size());
+        }
+        for (int col = 0; col < nf; ++col) k_outer[col + 1] += k_outer[col];
+        K_ff.resize(nf, nf), Q.resize(3 * n, n), mass.resize(n, n);
+        K_ff.resizeNonZeros(k_outer[nf]), Q.resizeNonZeros(q_outer[n]), mass.resizeNonZeros(m_outer[n]);
+        std::copy(k_outer.begin(), k_outer.end(), K_ff.outerIndexPtr());
+        std::copy(q_outer.begin(), q_outer.end(), Q.outerIndexPtr());
+        std::copy(m_outer.begin(), m_outer.end(), mass.outerIndexPtr());
+
         lumped_volume = Vector::Zero(n);
         f_ext = Vector::Zero(3 * n);
-        for (Index e = 0; e < mesh.tet_count(); ++e) {
-            const P1Tet& p = elements[e];
-            const Tet& t = mesh.tets[e];
-            const auto B = strain_displacement(p);
-            const Eigen::Matrix<Real, 12, 12> Ke = p.volume * B.transpose() * D * B;
-            for (int a = 0; a < 4; ++a)
-                for (int c = 0; c < 3; ++c) {
-                    for (int b = 0; b < 4; ++b)
-                        for (int d = 0; d < 3; ++d) k_entries.emplace_back(int(3 * t[a] + c), int(3 * t[b] + d), Ke(3 * a + c, 3 * b + d));
-                    for (int b = 0; b < 4; ++b)
-                        q_entries.emplace_back(int(3 * t[a] + c), int(t[b]), m.biot_coefficient * p.volume * p.grad[a][c] / 4);
+        elastic_lift = Vector::Zero(nf);
+        parallel_for(n, [&](Index b) {
+            const auto& nb = neighbours[b];
+            std::vector<Mat3> block(nb.size(), Mat3::Zero());
+            std::vector<Vec3> coupling(nb.size(), Vec3::Zero());
+            std::vector<Real> consistent(nb.size(), 0);
+            for (Index k = tet_start[b]; k < tet_start[b + 1]; ++k) {
+                const Index e = tet_list[k];
+                const P1Tet& p = elements[e];
+                const Tet& t = mesh.tets[e];
+                const int ib = int(std::find(t.begin(), t.end(), b) - t.begin());
+                const Vec3& gb = p.grad[ib];
+                for (int ia = 0; ia < 4; ++ia) {
+                    const size_t pos = size_t(std::lower_bound(nb.begin(), nb.end(), t[ia]) - nb.begin());
+                    const Vec3& ga = p.grad[ia];
+                    block[pos] += p.volume * (lambda * gb * ga.transpose() + mu * ga.dot(gb) * Mat3::Identity() + mu * ga * gb.transpose());
+                    coupling[pos] += (m.biot_coefficient * p.volume / 4) * ga;  // Q[3a+c, b]
+                    consistent[pos] += p.volume * (ia == ib ? 2 : 1) / 20;
                 }
-            for (int a = 0; a < 4; ++a)
-                for (int b = 0; b < 4; ++b) m_entries.emplace_back(int(t[a]), int(t[b]), p.volume * (a == b ? 2 : 1) / 20);
-            for (int a = 0; a < 4; ++a) {
-                lumped_volume[t[a]] += p.volume / 4;
-                f_ext.segment<3>(3 * t[a]) += m.bulk_density * problem.gravity * (p.volume / 4);
+                lumped_volume[b] += p.volume / 4;
+                f_ext.segment<3>(3 * b) += m.bulk_density * problem.gravity * (p.volume / 4);
             }
-        }
-        K.resize(3 * n, 3 * n);
-        K.setFromTriplets(k_entries.begin(), k_entries.end());
-        Q.resize(3 * n, n);
-        Q.setFromTriplets(q_entries.begin(), q_entries.end());
-        mass.resize(n, n);
-        mass.setFromTriplets(m_entries.begin(), m_entries.end());
-        if (problem.free_body) {
-            for (int i = 0; i < 3 * n; ++i) K.coeffRef(i, i) *= 1 + problem.rigid_mode_spring;
-        }
+            // K_ff columns of b (= rows, K is symmetric) and the lift of prescribed neighbours.
+            for (int d = 0; d < 3; ++d) {
+                const int col = free_u(b, d);
+                if (col < 0) continue;
+                int at = k_outer[col];
+                for (size_t pos = 0; pos < nb.size(); ++pos)
+                    for (int c = 0; c < 3; ++c) {
+                        const Real value = block[pos](d, c);
+                        if (const int row = free_u(nb[pos], c); row >= 0) {
+                            K_ff.innerIndexPtr()[at] = row;
+                            K_ff.valuePtr()[at++] = nb[pos] == b && c == d && problem.free_body ? value * (1 + problem.rigid_mode_spring) : value;
+                        } else {
+                            elastic_lift[col] += value * u_prescribed[3 * nb[pos] + c];
+                        }
+                    }
+            }
+            int at = q_outer[b];
+            for (size_t pos = 0; pos < nb.size(); ++pos)
+                for (int c = 0; c < 3; ++c) Q.innerIndexPtr()[at] = int(3 * nb[pos] + c), Q.valuePtr()[at++] = coupling[pos][c];
+            at = m_outer[b];
+            for (size_t pos = 0; pos < nb.size(); ++pos) mass.innerIndexPtr()[at] = int(nb[pos]), mass.valuePtr()[at++] = consistent[pos];
+        });
         for (Index a = 0; a < Index(problem.nodal_force.size()); ++a) f_ext.segment<3>(3 * a) += problem.nodal_force[a];
         storage = problem.material.storage * lumped_volume;
     }
@@ -283,7 +344,8 @@ struct BiotSolver::Impl {
         mobility_changed = true;
     }
 
-    void set_up_boundary() {
+    /// Free and prescribed unknowns, with the prescribed values.
+    void split_dofs() {
         std::vector<char> u_fixed(3 * n, 0), p_fixed(n, 0);
         u_prescribed = Vector::Zero(3 * n);
         p_prescribed = Vector::Zero(n);
@@ -306,10 +368,6 @@ struct BiotSolver::Impl {
             if (!attached[a]) u_fixed[3 * a] = u_fixed[3 * a + 1] = u_fixed[3 * a + 2] = p_fixed[a] = 1;
         u_dofs = DofSplit(u_fixed);
         p_dofs = DofSplit(p_fixed);
-        std::tie(K_ff, K_fc) = u_dofs.split(K);
-        std::tie(H_ff, H_fc) = p_dofs.split(H);
-        mass_ff = p_dofs.split(mass).first;
-        elastic_lift = K_fc * u_dofs.gather_prescribed(u_prescribed);
     }
 
     /// (S + L M + dt H)_ff, factorised when dt or the mobility changed.
