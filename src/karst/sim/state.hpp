@@ -37,6 +37,9 @@ struct FluidScratch {
     std::vector<Vec3> x_pred;       ///< (n) PCISPH predicted position, m
     std::vector<Real> rho_err;      ///< (n) clamped predicted density error, kg/m^3
     std::vector<Real> delta;        ///< (n) PCISPH scaling factor delta_i, Pa m^3/kg
+    std::vector<Real> pair_coefficient;  ///< per fluid pair (list layout): m_j / rho0^2 dW/dr / r
+    std::vector<Real> wall_coefficient;  ///< per wall pair: Psi_k / rho0^2 dW/dr / r
+    std::vector<Real> wall_hydrostatic;  ///< per wall pair: -rho0 g.x_ik, Pa
 };
 
 struct State {

@@ -24,25 +24,52 @@ namespace {
 void pressure_acceleration_and_prediction(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
-    const CubicKernel& W = model.kernel;
-    const Real inv_rho0_2 = 1 / (model.rho0 * model.rho0);
-    const Vec3 rho0_g = model.rho0 * model.scene.gravity;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity;
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i];
         const Real pi = f.p[i];
         Vec3 a = Vec3::Zero();
-        s.fluid_fluid.for_each(i, [&](Index j) {
-            const Vec3 xij = xi - f.x[j];
-            a -= (f.mass[j] * (pi + f.p[j]) * inv_rho0_2 * W.dw_over_r(xij.norm())) * xij;
-        });
-        if (pi != 0)
-            s.fluid_wall.for_each(i, [&](Index k) {
-                const Vec3 xik = xi - model.walls.x[k];
-                const Real pik = std::max(pi - rho0_g.dot(xik), Real(0));
-                a -= (model.walls.psi[k] * (pi + pik) * inv_rho0_2 * W.dw_over_r(xik.norm())) * xik;
+        const Real* cf = s.pair_coefficient.data() + i * cap_f;
+        int k = 0;
+        s.fluid_fluid.for_each(i, [&](Index j) { a -= ((pi + f.p[j]) * cf[k++]) * (xi - f.x[j]); });
+        if (pi != 0) {
+            const Real* cw = s.wall_coefficient.data() + i * cap_w;
+            const Real* hw = s.wall_hydrostatic.data() + i * cap_w;
+            k = 0;
+            s.fluid_wall.for_each(i, [&](Index w) {
+                const Real pik = std::max(pi + hw[k], Real(0));
+                a -= ((pi + pik) * cw[k++]) * (xi - model.walls.x[w]);
             });
+        }
         s.a_pressure[i] = a;
         s.x_pred[i] = xi + dt * (f.v[i] + dt * (s.a_other[i] + a));
+    });
+}
+
+/// The parts of the pressure acceleration that stay fixed through the iterations, per pair:
+/// m_j / rho0^2 dW/dr / r (fluid), Psi_k / rho0^2 dW/dr / r and -rho0 g.x_ik (walls). Computing
+/// them once per step saves a square root, a division and the kernel in every iteration.
+void pair_coefficients(const Model& model, State& state) {
+    const FluidParticles& f = state.fluid;
+    FluidScratch& s = state.scratch;
+    const CubicKernel& W = model.kernel;
+    const Real inv_rho0_2 = 1 / (model.rho0 * model.rho0);
+    const Vec3 rho0_g = model.rho0 * model.scene.gravity;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity;
+    s.pair_coefficient.resize(size_t(f.size()) * cap_f);
+    s.wall_coefficient.resize(size_t(f.size()) * cap_w);
+    s.wall_hydrostatic.resize(size_t(f.size()) * cap_w);
+    parallel_for(f.size(), [&](Index i) {
+        int k = 0;
+        s.fluid_fluid.for_each(i, [&](Index j) {
+            s.pair_coefficient[i * cap_f + k++] = f.mass[j] * inv_rho0_2 * W.dw_over_r((f.x[i] - f.x[j]).norm());
+        });
+        k = 0;
+        s.fluid_wall.for_each(i, [&](Index w) {
+            const Vec3 xik = f.x[i] - model.walls.x[w];
+            s.wall_coefficient[i * cap_w + k] = model.walls.psi[w] * inv_rho0_2 * W.dw_over_r(xik.norm());
+            s.wall_hydrostatic[i * cap_w + k++] = -rho0_g.dot(xik);
+        });
     });
 }
 
@@ -91,6 +118,7 @@ PcisphReport solve_pressure_pcisph(const Model& model, State& state, Real dt) {
     s.x_pred.resize(n);
     s.rho_err.resize(n);
     compute_delta(model, state, dt, s.delta);
+    pair_coefficients(model, state);
     s.a_pressure.assign(n, Vec3::Zero());
     parallel_for(n, [&](Index i) { s.x_pred[i] = f.x[i] + dt * (f.v[i] + dt * s.a_other[i]); });
 
