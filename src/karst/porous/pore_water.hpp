@@ -1,5 +1,6 @@
 #pragma once
 // The pore-water state of porous particles and its constitutive laws (method.md §2, M3-M6).
+#include "karst/core/soa.hpp"
 #include "karst/core/types.hpp"
 
 #include <algorithm>
@@ -15,9 +16,16 @@ struct PorousParticles {
     std::vector<Real> volume;          ///< bulk volume V, m^3
     std::vector<Real> porosity;        ///< phi
     std::vector<Real> absorbed_mass;   ///< m_p, kg
+    std::vector<Real> solid_mass;      ///< m_s = rho_s (1 - phi0) V0, kg
+    std::vector<Vec3> v;               ///< world velocity (from the fragment), m/s
     std::vector<Mat3> permeability;    ///< world tensor K (M12), m^2
     std::vector<Index> fragment;       ///< pairs in different fragments exchange only in contact
     Index size() const { return Index(x.size()); }
+    /// Keeps the particles whose flag is set, in order.
+    void keep(const std::vector<char>& flag) {
+        keep_flagged(x, flag), keep_flagged(volume, flag), keep_flagged(porosity, flag), keep_flagged(absorbed_mass, flag);
+        keep_flagged(solid_mass, flag), keep_flagged(v, flag), keep_flagged(permeability, flag), keep_flagged(fragment, flag);
+    }
 };
 
 /// Below this porosity a particle is impermeable (M3) and takes part in no transfer.

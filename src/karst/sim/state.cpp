@@ -1,18 +1,9 @@
 #include "karst/sim/state.hpp"
 
+#include "karst/core/soa.hpp"
 #include "karst/sim/model.hpp"
 
 namespace karst {
-
-namespace {
-template <class T>
-void keep_flagged(std::vector<T>& a, const std::vector<char>& flag) {
-    size_t k = 0;
-    for (size_t i = 0; i < a.size(); ++i)
-        if (flag[i]) a[k++] = a[i];
-    a.resize(k);
-}
-}  // namespace
 
 void FluidParticles::keep(const std::vector<char>& flag) {
     keep_flagged(x, flag), keep_flagged(v, flag), keep_flagged(mass, flag), keep_flagged(solute, flag);

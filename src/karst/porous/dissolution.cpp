@@ -1,0 +1,49 @@
+#include "karst/porous/dissolution.hpp"
+
+#include <cmath>
+
+namespace karst {
+
+namespace {
+
+/// Offsets of the pieces of a split particle: the corners of a cube of edge 0.1 dx, cycled.
+Vec3 piece_offset(int piece, Real dx) {
+    const Vec3 corner((piece & 1) ? 1 : -1, (piece & 2) ? 1 : -1, (piece & 4) ? 1 : -1);
+    return (0.05 * dx) * corner * (1 + piece / 8);
+}
+
+}  // namespace
+
+DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, const PoreWaterLaw& law,
+                           const DissolutionSettings& settings, std::int64_t& next_id) {
+    DissolutionReport report;
+    std::vector<char> keep(porous.size(), 1);
+    for (Index i = 0; i < porous.size(); ++i) {
+        const Real phi = porous.porosity[i];
+        if (phi < settings.porosity) continue;
+        if (law.saturation(porous.absorbed_mass[i], phi, porous.volume[i]) < settings.saturation) continue;
+        keep[i] = 0, ++report.dissolved;
+        const Real m = porous.solid_mass[i] + porous.absorbed_mass[i], solute = porous.solid_mass[i];
+        const int pieces = m > 2 * settings.fluid_particle_mass ? int(std::ceil(m / settings.fluid_particle_mass)) : 1;
+        // Equal pieces, the last taking the rounding remainder, so the sums are exact.
+        Real mass_left = m, solute_left = solute;
+        for (int k = 0; k < pieces; ++k) {
+            const bool last = k == pieces - 1;
+            const Real mk = last ? mass_left : m / pieces, sk = last ? solute_left : solute / pieces;
+            mass_left -= mk, solute_left -= sk;
+            fluid.x.push_back(porous.x[i] + (pieces > 1 ? piece_offset(k, settings.spacing) : Vec3::Zero()));
+            fluid.v.push_back(porous.v[i]);
+            fluid.mass.push_back(mk);
+            fluid.solute.push_back(sk);
+            fluid.rho.push_back(law.rest_density);
+            fluid.p.push_back(0);
+            fluid.id.push_back(next_id++);
+            ++report.fluid_created;
+        }
+    }
+    if (report.dissolved == 0) return report;
+    porous.keep(keep);
+    return report;
+}
+
+}  // namespace karst
