@@ -1,0 +1,45 @@
+#include "karst/rigid/contact.hpp"
+
+#include "karst/core/parallel.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace karst {
+
+ContactLaw ContactLaw::for_fragments(Real spacing, Real fragment_mass, Real gravity, Real particle_mass, Real restitution) {
+    ContactLaw law;
+    law.rest_distance = spacing;
+    law.stiffness = fragment_mass * gravity / (0.01 * spacing);
+    // A damped oscillator of reduced mass m/2 rebounds with e = exp(-pi zeta / sqrt(1 - zeta^2)).
+    const Real log_e = std::log(restitution);
+    const Real zeta = -log_e / std::sqrt(std::numbers::pi * std::numbers::pi + log_e * log_e);
+    law.damping = 2 * zeta * std::sqrt(law.stiffness * 0.5 * particle_mass);
+    return law;
+}
+
+Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbours, const ContactLaw& law,
+                         std::vector<Vec3>& force) {
+    std::vector<Index> touching(p.size(), 0);
+    parallel_for(p.size(), [&](Index i) {
+        Vec3 sum = Vec3::Zero();
+        neighbours.for_each(i, [&](Index j) {
+            if (p.fragment[i] == p.fragment[j]) return;
+            // Evaluated in (min, max) order so that the pair's two forces are bitwise opposite.
+            const Index lo = std::min(i, j), hi = std::max(i, j);
+            const Vec3 x = p.x[lo] - p.x[hi];
+            const Real r = x.norm();
+            if (r >= law.rest_distance || r == 0) return;
+            const Vec3 n = x / r;
+            const Vec3 on_lo = (law.stiffness * (law.rest_distance - r) - law.damping * (p.v[lo] - p.v[hi]).dot(n)) * n;
+            sum += i == lo ? on_lo : Vec3(-on_lo);
+            ++touching[i];
+        });
+        force[i] += sum;
+    });
+    Index pairs = 0;
+    for (Index t : touching) pairs += t;
+    return pairs / 2;
+}
+
+}  // namespace karst

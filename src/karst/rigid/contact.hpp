@@ -1,0 +1,25 @@
+#pragma once
+// Contact springs between porous particles of different fragments (method.md §4.2):
+//   F_{i<-j} = [k_c (d0 - r) - c_c (v_ij . r_hat)] r_hat   for r < d0 = dx,
+// applied in equal and opposite pairs. Springs inside one fragment would cancel in its rigid sum,
+// so only pairs across fragments count.
+#include "karst/porous/pore_water.hpp"
+#include "karst/sph/neighbour_grid.hpp"
+
+namespace karst {
+
+struct ContactLaw {
+    Real rest_distance = 0.02;  ///< d0 = dx, m
+    Real stiffness = 0;         ///< k_c, N/m
+    Real damping = 0;           ///< c_c, N s/m
+    /// k_c = M g / (0.01 dx) for the lightest fragment M in contact (method.md §4.2), and the
+    /// damping that gives a normal restitution e for two particles of mass m_pair each.
+    static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity, Real particle_mass, Real restitution = 0.2);
+};
+
+/// Adds the contact forces (N) into `force` (one per particle); `neighbours` lists particles
+/// within d0 (any fragment). Returns the number of touching pairs.
+Index add_contact_forces(const PorousParticles& particles, const NeighbourLists& neighbours, const ContactLaw& law,
+                         std::vector<Vec3>& force);
+
+}  // namespace karst
