@@ -35,6 +35,7 @@ struct MeshFrame {
 struct FrameParts {
     const FluidParticles* fluid = nullptr;
     const MeshFrame* mesh = nullptr;
+    const PointSet* porous = nullptr;  ///< porous particles with their pore state
 };
 
 class FrameWriter {
@@ -42,7 +43,8 @@ public:
     /// Creates `dir` and removes frame files a previous run left there.
     FrameWriter(std::filesystem::path dir, const OutputSettings& settings);
     void write_boundary(const WallParticles& walls);
-    /// fluid_NNNN.vtp/.ply and mesh_NNNN.vtu as present, then run.pvd and log.csv anew.
+    /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu and porous_NNNN.vtp as present, then run.pvd and
+    /// log.csv anew.
     void write_frame(const FrameParts& parts, const FrameLog& log);
     void write_stats(const nlohmann::json& stats) const;
     int frames() const { return int(m_log.size()); }
@@ -53,7 +55,7 @@ private:
     OutputSettings m_settings;
     bool m_has_boundary = false;
     std::vector<FrameLog> m_log;
-    struct Written { bool fluid, mesh; };
+    struct Written { bool fluid, mesh, porous; };
     std::vector<Written> m_written;  ///< which parts each frame has
 };
 

@@ -3,6 +3,8 @@
 #include "karst/core/timer.hpp"
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/porosity.hpp"
+#include "karst/porous/permeability.hpp"
+#include "karst/sph/kernels.hpp"
 
 #include <limits>
 
@@ -39,7 +41,9 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     BiotProblem p;
     p.material = biot_material(model, solid.material);
     p.gravity = model.scene.gravity;
-    p.mobility.assign(mesh.tet_count(), (solid.material.permeability / solid.material.darcy_viscosity) * Mat3::Identity());
+    const PorousMaterial& mat = solid.material;
+    const Mat3 K0 = layered_permeability(mat.permeability, mat.layering_normal, mat.layering_ratio);
+    p.mobility.assign(mesh.tet_count(), K0 / mat.darcy_viscosity);
     const Index n = mesh.node_count();
     p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0), p.nodal_force.assign(n, Vec3::Zero());
     // A node is on a region when inside it or within 3/4 of a spacing: the outer particle layer
@@ -69,6 +73,18 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     return p;
 }
 
+/// Appends the arrays of `local` to those of `into` (by name), creating them for the first solid.
+void append_arrays(PointSet& into, const PointSet& local) {
+    for (const PointArray& array : local.arrays) {
+        auto it = std::find_if(into.arrays.begin(), into.arrays.end(), [&](const PointArray& a) { return a.name == array.name; });
+        if (it == into.arrays.end()) {
+            into.arrays.push_back({array.name, array.components, array.integer, {}});
+            it = std::prev(into.arrays.end());
+        }
+        it->values.insert(it->values.end(), array.values.begin(), array.values.end());
+    }
+}
+
 BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh& mesh, PfemTimings& timings) {
     const PoroelasticSettings& pe = model.scene.poroelastic;
     BiotOptions options;
@@ -86,6 +102,8 @@ BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh
 PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings)
     : m_scene(model.scene.porous_solids[body.solid]),
       m_feedback(model.scene.poroelastic.permeability_feedback),
+      m_pore_water(model.scene.poroelastic.pressure_from_pore_water),
+      m_h(model.h),
       m_mesh(mesh_body(model, body, timings)),
       m_solver(make_solver(model, body, m_mesh, timings)),
       m_fields{std::vector<Vec3>(m_mesh.node_count(), Vec3::Zero()), std::vector<Real>(m_mesh.node_count(), 0)} {
@@ -94,9 +112,45 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
     for (Index a = 0; a < m_mesh.node_count(); ++a)
         if (m_solver.problem().drained[a]) m_fields.p[a] = m_solver.problem().drained_pressure[a];
     m_assembled_k.assign(m_mesh.tet_count(), m_scene.material.permeability);
+
+    // The pore water on the particles (method.md §2, §4.7): the mesh nodes are the particles.
+    const PorousMaterial& mat = m_scene.material;
+    m_body_tensor = layered_permeability(mat.permeability, mat.layering_normal, mat.layering_ratio);
+    m_law.rest_density = model.rho0, m_law.capillary_scale = mat.capillary_pressure;
+    m_law.capillary_exponent = mat.capillary_exponent, m_law.pore_stiffness = mat.pore_stiffness;
+    m_law.saturation_exponent = mat.saturation_exponent, m_law.darcy_viscosity = mat.darcy_viscosity;
+    m_law.gravity = model.scene.gravity;
+    const Real V0 = model.dx * model.dx * model.dx;
+    PorousParticles& p = m_particles;
+    for (const Vec3& x : body.rest_x) {
+        Real S = mat.initial_saturation;
+        for (const WetRegion& w : m_scene.wet_regions)
+            if (w.region.signed_distance(x) <= 0) S = w.saturation;
+        p.x.push_back(x), p.v.push_back(Vec3::Zero()), p.volume.push_back(V0), p.porosity.push_back(mat.porosity);
+        p.absorbed_mass.push_back(S * model.rho0 * mat.porosity * V0);
+        p.solid_mass.push_back(mat.solid_density * (1 - mat.porosity) * V0);
+        p.permeability.push_back(m_body_tensor), p.fragment.push_back(body.solid);
+    }
+    const Real reach = kernel_reach(m_body_tensor, model.h);
+    Aabb box;
+    for (const Vec3& x : p.x) box.extend(x);
+    const UniformGrid grid(box.padded(reach), reach);
+    CellRanges cells;
+    sort_into_cells(grid, p.x, cells);
+    find_neighbours(grid, p.x, cells, true, m_pairs);
+    m_flow = std::make_unique<PoreFlow>(m_law, model.h, model.dx);
 }
 
 BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {
+    if (m_pore_water) {
+        Stopwatch watch;
+        m_flow->advance(m_particles, m_pairs, dt);
+        timings.pore_flow += watch.seconds();
+        // p^n <- P^p (M5) from the pore water at every node; the Biot p is kept for output only.
+        for (Index a = 0; a < m_mesh.node_count(); ++a)
+            if (!m_solver.problem().drained[a])
+                m_fields.p[a] = m_law.pore_pressure(m_law.saturation(m_particles.absorbed_mass[a], m_particles.porosity[a], m_particles.volume[a]));
+    }
     const BiotCallReport r = m_solver.advance(dt, m_fields);
     timings.factorisation += r.seconds_flow_factorisation;
     timings.iterations += r.seconds_iterations;
@@ -114,9 +168,13 @@ void PoroelasticSolid::refresh_permeability() {
     const NodalStress stress = nodal_stress(m_mesh, m_solver.problem().material, m_fields);
     const PorousMaterial& mat = m_scene.material;
     std::vector<Real> k(m_mesh.node_count());
-    for (Index a = 0; a < m_mesh.node_count(); ++a)
-        k[a] = kozeny_carman_permeability(mat.permeability, mat.porosity,
-                                          dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus));
+    for (Index a = 0; a < m_mesh.node_count(); ++a) {
+        const Real phi = dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus);
+        k[a] = kozeny_carman_permeability(mat.permeability, mat.porosity, phi);
+        // The particles follow (M12 with R = I): their porosity sets S, their tensor the flow.
+        m_particles.porosity[a] = phi;
+        m_particles.permeability[a] = (k[a] / mat.permeability) * m_body_tensor;
+    }
     std::vector<Real> tet_k(m_mesh.tet_count());
     bool changed = false;
     for (Index e = 0; e < m_mesh.tet_count(); ++e) {
@@ -126,7 +184,7 @@ void PoroelasticSolid::refresh_permeability() {
     }
     if (!changed) return;
     std::vector<Mat3> mobility(m_mesh.tet_count());
-    for (Index e = 0; e < m_mesh.tet_count(); ++e) mobility[e] = (tet_k[e] / mat.darcy_viscosity) * Mat3::Identity();
+    for (Index e = 0; e < m_mesh.tet_count(); ++e) mobility[e] = (tet_k[e] / (mat.permeability * mat.darcy_viscosity)) * m_body_tensor;
     m_solver.set_mobility(std::move(mobility));
     m_assembled_k = std::move(tet_k);
 }
@@ -140,18 +198,9 @@ void PoroelasticSolid::append_to(MeshFrame& frame) const {
     std::vector<Mat3> permeability(n);
     for (Index a = 0; a < n; ++a) {
         porosity[a] = dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus);
-        permeability[a] = kozeny_carman_permeability(mat.permeability, mat.porosity, porosity[a]) * Mat3::Identity();
+        permeability[a] = (kozeny_carman_permeability(mat.permeability, mat.porosity, porosity[a]) / mat.permeability) * m_body_tensor;
         crack[a] = stress.principal[a][0] / mat.tensile_strength;
     }
-    // The arrays of earlier solids are extended, or created on the first solid.
-    auto extend = [&](const std::string& name, int components, const std::vector<double>& values) {
-        auto it = std::find_if(frame.nodes.arrays.begin(), frame.nodes.arrays.end(), [&](const PointArray& a) { return a.name == name; });
-        if (it == frame.nodes.arrays.end()) {
-            frame.nodes.arrays.push_back({name, components, false, {}});
-            it = std::prev(frame.nodes.arrays.end());
-        }
-        it->values.insert(it->values.end(), values.begin(), values.end());
-    };
     PointSet local;
     local.add_vector("displacement", m_fields.u);
     local.add_scalar("pore_pressure", m_fields.p);
@@ -160,9 +209,45 @@ void PoroelasticSolid::append_to(MeshFrame& frame) const {
     local.add_symmetric_tensor("effective_stress", stress.effective);
     local.add_vector("principal_stress", stress.principal);
     local.add_scalar("crack_candidate", crack);
-    for (const PointArray& a : local.arrays) extend(a.name, a.components, a.values);
+    append_arrays(frame.nodes, local);
     frame.nodes.x.insert(frame.nodes.x.end(), m_mesh.nodes.begin(), m_mesh.nodes.end());
     for (const Tet& t : m_mesh.tets) frame.tets.push_back({t[0] + offset, t[1] + offset, t[2] + offset, t[3] + offset});
+}
+
+Real PoroelasticSolid::absorbed_water() const {
+    Real sum = 0;
+    for (Real m : m_particles.absorbed_mass) sum += m;
+    return sum;
+}
+
+void PoroelasticSolid::append_particles_to(PointSet& points, Index fragment) const {
+    const PorousParticles& p = m_particles;
+    const Index n = p.size();
+    std::vector<Real> S(n), phi(n), pore_pressure(n), potential(n);
+    for (Index i = 0; i < n; ++i) {
+        S[i] = m_law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]);
+        pore_pressure[i] = m_law.pore_pressure(S[i]);
+        potential[i] = m_law.flow_potential(S[i], p.x[i]);
+    }
+    // M17: v_p = -(k_r K / (phi eta)) grad Phi, grad Phi = sum_j V_j (Phi_j - Phi_i) grad W_ij.
+    const CubicKernel W(m_h);
+    std::vector<Vec3> velocity(n, Vec3::Zero());
+    for (Index i = 0; i < n; ++i) {
+        Vec3 grad = Vec3::Zero();
+        m_pairs.for_each(i, [&](Index j) { grad += p.volume[j] * (potential[j] - potential[i]) * W.gradient(p.x[i] - p.x[j]); });
+        const Real kr = std::pow(std::min(S[i], Real(1)), m_law.saturation_exponent);
+        velocity[i] = -(kr / (p.porosity[i] * m_law.darcy_viscosity)) * (p.permeability[i] * grad);
+    }
+    PointSet local;
+    local.add_scalar("saturation", S);
+    local.add_scalar("porosity", p.porosity);
+    local.add_scalar("absorbed_mass", p.absorbed_mass);
+    local.add_scalar("pore_pressure", pore_pressure);
+    local.add_vector("pore_velocity", velocity);
+    local.add_integer("fragment", std::vector<std::int64_t>(n, fragment));
+    local.add_symmetric_tensor("permeability", p.permeability);
+    append_arrays(points, local);
+    points.x.insert(points.x.end(), p.x.begin(), p.x.end());
 }
 
 }  // namespace karst

@@ -3,13 +3,16 @@
 // Biot problem its scene entry describes, the fields u and p, and what a frame shows of them.
 #include "karst/io/frame_writer.hpp"
 #include "karst/pfem/biot.hpp"
+#include "karst/porous/pore_flow.hpp"
 #include "karst/sim/model.hpp"
+
+#include <memory>
 
 namespace karst {
 
 /// Seconds spent per PFEM phase, summed over solids and calls (stats.json "phases").
 struct PfemTimings {
-    Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0;
+    Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0, pore_flow = 0;
     Index biot_calls = 0, biot_iterations = 0;
     bool all_converged = true;
 };
@@ -19,8 +22,17 @@ public:
     /// Meshes the body and assembles its Biot problem (factorising the elasticity matrix).
     PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings);
 
-    /// One Biot call over dt (M22), then the porosity/permeability feedback (§5.4).
+    /// One step over dt: the pore water moves (M15, with /poroelastic/pressure_source
+    /// pore_water) and seeds the Biot pressure (M5), one Biot call (M22), then the porosity and
+    /// permeability feedback (§5.4) into the mesh and the particles.
     BiotCallReport advance(Real dt, PfemTimings& timings);
+
+    /// The solid's particles with saturation, porosity, absorbed_mass, pore_pressure (M5),
+    /// pore_velocity (M17), fragment and permeability (6 components), for porous_NNNN.vtp.
+    void append_particles_to(PointSet& points, Index fragment) const;
+
+    /// Pore water held by the solid, kg.
+    Real absorbed_water() const;
 
     /// Appends this solid's nodes (rest positions) and tets to `frame`, with the point arrays
     /// displacement, pore_pressure, porosity (M23), permeability (M24, 6 components),
@@ -35,7 +47,13 @@ private:
     void refresh_permeability();
 
     const PorousSolid& m_scene;
-    bool m_feedback;
+    bool m_feedback, m_pore_water;
+    Real m_h;                   ///< SPH support radius, m
+    Mat3 m_body_tensor;         ///< K0 (M12), m^2
+    PoreWaterLaw m_law;
+    PorousParticles m_particles;
+    NeighbourLists m_pairs;
+    std::unique_ptr<PoreFlow> m_flow;
     Real m_grain_bulk_modulus;  ///< K_s = K_dr / (1 - B), Pa
     TetMesh m_mesh;
     BiotSolver m_solver;

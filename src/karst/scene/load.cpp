@@ -102,6 +102,15 @@ Scene parse_scene(const std::string& text) {
         mat.solid_density = m["solid_density"], mat.youngs_modulus = m["youngs_modulus"];
         mat.poisson_ratio = m["poisson_ratio"], mat.biot_coefficient = m["biot_coefficient"];
         mat.tensile_strength = m["tensile_strength"];
+        mat.capillary_pressure = m["capillary_pressure"], mat.capillary_exponent = m["capillary_exponent"];
+        mat.pore_stiffness = m["pore_stiffness"], mat.saturation_exponent = m["saturation_exponent"];
+        mat.initial_saturation = m["initial_saturation"];
+        mat.layering_normal = vec3(j["layering"]["normal"]), mat.layering_ratio = j["layering"]["ratio"];
+        if (mat.layering_normal.norm() < 1e-6)
+            throw SceneError(solid.path + "/layering/normal", "a non-zero direction", "[0, 0, 0]");
+        for (size_t w = 0; w < j["wet_regions"].size(); ++w)
+            solid.wet_regions.push_back({read_shape(j["wet_regions"][w]["region"], fmt::format("{}/wet_regions/{}/region", solid.path, w)),
+                                         j["wet_regions"][w]["saturation"].get<Real>()});
         if (mat.biot_coefficient < mat.porosity)  // else the grains would have negative storage
             throw SceneError(solid.path + "/material/biot_coefficient", fmt::format("a value at least the porosity {}", mat.porosity),
                              fmt::format("{}", mat.biot_coefficient));
@@ -123,6 +132,7 @@ Scene parse_scene(const std::string& text) {
     const json& pe = doc["poroelastic"];
     s.poroelastic.time_step = pe["time_step"], s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
     s.poroelastic.fixed_strain = pe["splitting"] == "fixed_strain";
+    s.poroelastic.pressure_from_pore_water = pe["pressure_source"] == "pore_water";
     s.poroelastic.mfem_polyhedra = pe["shape_functions"] == "mfem_polyhedra";
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];

@@ -56,6 +56,18 @@ struct PorousMaterial {
     Real poisson_ratio = 0.25;
     Real biot_coefficient = 0.9;    ///< B
     Real tensile_strength = 1e5;    ///< sigma_t, Pa
+    Real capillary_pressure = 2000;   ///< k^c, Pa
+    Real capillary_exponent = 0.5;    ///< alpha
+    Real pore_stiffness = 1.4e4;      ///< k^p, Pa
+    Real saturation_exponent = 2;     ///< beta
+    Real initial_saturation = 0;
+    Vec3 layering_normal{0, 0, 1};
+    Real layering_ratio = 1;          ///< k along / k across the layers
+};
+
+struct WetRegion {
+    Shape region;
+    Real saturation = 1;
 };
 
 /// A boundary condition of the Biot problem on a region of a porous solid.
@@ -73,6 +85,7 @@ struct PorousSolid {
     Shape shape;
     PorousMaterial material;
     std::vector<Constraint> constraints;
+    std::vector<WetRegion> wet_regions;
     std::string path;
 };
 
@@ -80,6 +93,7 @@ struct PoroelasticSettings {
     Real time_step = 1.0 / 30;       ///< dt_B, s
     Real fluid_bulk_modulus = 1e5;   ///< K_f, Pa
     bool fixed_strain = false;       ///< the paper's splitting instead of fixed-stress
+    bool pressure_from_pore_water = true;  ///< seed p^n from M5 each call (else carry the Biot p)
     bool mfem_polyhedra = false;     ///< M21 shape functions instead of P1
     int max_iterations = 5;
     Real tolerance = 1e-3;

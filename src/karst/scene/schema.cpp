@@ -117,6 +117,26 @@ std::vector<KeySpec> make_schema() {
             "Biot coefficient B = 1 - K_dr/K_s; it fixes the grain modulus K_s."),
         key("/porous_solids/[]/material/tensile_strength", T::Number, "Pa", positive(1e12), 1e5,
             "Tensile strength sigma_t of the Rankine test (M25); output marks crack candidates."),
+        key("/porous_solids/[]/material/capillary_pressure", T::Number, "Pa", closed(0, 1e8), 2000.0,
+            "Capillary scale k^c of M4: the suction of dry material."),
+        key("/porous_solids/[]/material/capillary_exponent", T::Number, "", closed(0.01, 1), 0.5,
+            "Exponent alpha of M4, P^c = k^c (1 - S)^alpha."),
+        key("/porous_solids/[]/material/pore_stiffness", T::Number, "Pa", closed(1, 1e10), 1.4e4,
+            "Pore stiffness k^p of M5, P^p = k^p S max(0, S^7 - 1)."),
+        key("/porous_solids/[]/material/saturation_exponent", T::Number, "", closed(0, 6), 2.0,
+            "Exponent beta of the relative permeability k_r = S^beta."),
+        key("/porous_solids/[]/material/initial_saturation", T::Number, "", closed(0, 1.2), 0.0,
+            "Saturation S at t = 0 outside the wet regions."),
+        key("/porous_solids/[]/layering", T::Object, "", any(), json::object(),
+            "Bedding planes of a layered rock (M12): permeability ratio along / across the layers."),
+        key("/porous_solids/[]/layering/normal", T::Vec3, "", closed(-1, 1), json::array({0.0, 0.0, 1.0}),
+            "Bedding-plane normal in the solid's frame."),
+        key("/porous_solids/[]/layering/ratio", T::Number, "", closed(0.01, 100), 1.0,
+            "k along the layers / k across them (1: isotropic); det K stays k0^3."),
+        key("/porous_solids/[]/wet_regions", T::ObjectArray, "", any(), json::array(),
+            "Regions of the solid that start wet."),
+        required("/porous_solids/[]/wet_regions/[]/region", T::Shape, "", any(), "Where the solid starts wet."),
+        key("/porous_solids/[]/wet_regions/[]/saturation", T::Number, "", closed(0, 1.2), 1.0, "Saturation there."),
         key("/porous_solids/[]/constraints", T::ObjectArray, "", any(), json::array(),
             "Boundary conditions of the Biot problem on regions of the solid. A node belongs to a "
             "region when it lies inside it or within 3/4 of a spacing of it (the outer particles sit half a spacing inside the geometry). Unconstrained: free "
@@ -139,6 +159,11 @@ std::vector<KeySpec> make_schema() {
         key("/poroelastic/fluid_bulk_modulus", T::Number, "Pa", closed(1, 1e12), 1e5,
             "Pore-water bulk modulus K_f in the Biot storage 1/M = phi/K_f + (B - phi)/K_s. The "
             "default is the SPH pore stiffness gamma k^p (method.md §8.2); water is 2.2e9."),
+        key("/poroelastic/pressure_source", T::Enum, "", any(), "pore_water",
+            "pore_water: the pore water moves by Darcy flow among the particles (M15) and seeds the "
+            "Biot pressure at every call from M5 (method.md §5.3); biot: the Biot pressure is "
+            "carried from call to call (linear poroelasticity, e.g. Terzaghi's test).",
+            {"pore_water", "biot"}),
         key("/poroelastic/splitting", T::Enum, "", any(), "fixed_stress",
             "fixed_stress (M22, L = B^2/K_dr) or fixed_strain (the paper's order, L = 0; diverges "
             "when tau = B^2 M/K_dr > 1).",

@@ -32,9 +32,19 @@ RunResult run_poroelastic(const Model& model, const RunOptions& options) {
     out.write_boundary(model.walls);
     auto write_frame = [&](Real time, Real dt, Index steps) {
         MeshFrame frame;
-        for (const PoroelasticSolid& s : solids) s.append_to(frame);
-        out.write_frame({nullptr, &frame}, {time, dt, steps, nodes, 0, 0});
+        PointSet particles;
+        for (size_t s = 0; s < solids.size(); ++s) {
+            solids[s].append_to(frame);
+            solids[s].append_particles_to(particles, Index(s));
+        }
+        out.write_frame({nullptr, &frame, &particles}, {time, dt, steps, nodes, 0, 0});
     };
+    auto absorbed = [&] {
+        Real sum = 0;
+        for (const PoroelasticSolid& s : solids) sum += s.absorbed_water();
+        return sum;
+    };
+    const Real absorbed_initial = absorbed();
     write_frame(0, 0, 0);
 
     const Real end = scene.time.end, frame_dt = 1 / scene.output.fps;
@@ -71,13 +81,15 @@ RunResult run_poroelastic(const Model& model, const RunOptions& options) {
         {"sim_time", time},
         {"wall_time", wall.seconds()},
         {"phases", {{"meshing", timings.meshing}, {"assembly", timings.assembly},
-                    {"factorisation", timings.factorisation}, {"iterations", timings.iterations}}},
+                    {"factorisation", timings.factorisation}, {"iterations", timings.iterations},
+                    {"pore_flow", timings.pore_flow}}},
         {"biot", {{"calls", timings.biot_calls}, {"iterations", timings.biot_iterations},
                   {"mean_iterations", timings.biot_calls ? double(timings.biot_iterations) / timings.biot_calls : 0.0},
                   {"all_converged", timings.all_converged}}},
         {"mesh", {{"kept", quality.kept}, {"polyhedra", quality.polyhedra}, {"slivers_dropped", quality.slivers_dropped},
                   {"interior_slivers", quality.interior_slivers}}},
-        {"mass", {{"water_initial", 0.0}, {"water_final", 0.0}, {"solute_initial", 0.0}, {"solute_final", 0.0}}},
+        {"mass", {{"water_initial", absorbed_initial}, {"water_final", absorbed()}, {"absorbed_initial", absorbed_initial},
+                  {"absorbed_final", absorbed()}, {"solute_initial", 0.0}, {"solute_final", 0.0}}},
         {"max_density_error", 0.0},
         {"mipps", node_steps / std::max(stepping.seconds(), 1e-9) / 1e6},  // node-steps of the Biot solver
         {"threads", ThreadLimit::active_threads()},
