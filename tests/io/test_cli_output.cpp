@@ -1,5 +1,7 @@
 // The CLI writes a complete output folder for a tiny scene, run.pvd lists every frame with its
 // time, bad input exits with 2 and writes nothing, and the watchdog exits with 1.
+#include "support/files.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -12,12 +14,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using karst::test::read_text;
 
 int karst(const std::string& args) {
     const int status = std::system((std::string(KARST_BINARY) + " " + args + " 2>/dev/null").c_str());
@@ -52,7 +49,7 @@ TEST(Cli, WritesCompleteOutputFolder) {
         std::snprintf(name, sizeof name, "fluid_%04d", f);
         EXPECT_TRUE(fs::exists(out / (std::string(name) + ".vtp"))) << name;
         EXPECT_TRUE(fs::exists(out / (std::string(name) + ".ply"))) << name;
-        const std::string vtp = slurp(out / (std::string(name) + ".vtp"));
+        const std::string vtp = read_text(out / (std::string(name) + ".vtp"));
         EXPECT_NE(vtp.find("<Verts>"), std::string::npos);
         for (const char* array : {"velocity", "density", "pressure", "\"id\""}) EXPECT_NE(vtp.find(array), std::string::npos);
         EXPECT_TRUE(vtp.ends_with("</VTKFile>\n"));
@@ -62,7 +59,7 @@ TEST(Cli, WritesCompleteOutputFolder) {
     for (const auto& e : fs::directory_iterator(out)) EXPECT_NE(e.path().extension(), ".tmp") << e.path();
 
     // run.pvd: every frame with its exact time, plus the boundary part.
-    const std::string pvd = slurp(out / "run.pvd");
+    const std::string pvd = read_text(out / "run.pvd");
     const std::regex fluid_entry(R"re(timestep="([0-9.e-]+)" part="0" file="fluid_(\d{4}).vtp")re");
     int frames = 0;
     for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), fluid_entry); it != std::sregex_iterator(); ++it, ++frames) {
@@ -72,9 +69,9 @@ TEST(Cli, WritesCompleteOutputFolder) {
     EXPECT_EQ(frames, 6);
     EXPECT_NE(pvd.find("part=\"1\" file=\"boundary.vtp\""), std::string::npos);
 
-    const std::string log = slurp(out / "log.csv");
+    const std::string log = read_text(out / "log.csv");
     EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 7);  // header + 6 frames
-    const auto stats = nlohmann::json::parse(slurp(out / "stats.json"));
+    const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
     for (const char* key : {"counts", "steps", "frames", "sim_time", "wall_time", "phases", "mass",
                             "max_density_error", "mipps", "threads", "version"})
         EXPECT_TRUE(stats.contains(key)) << key;
@@ -108,7 +105,7 @@ TEST(Cli, WatchdogStopsWithOneAfterWritingTheLastGoodFrame) {
     std::ofstream(dir.path / "w.json") << scene;
     const fs::path out = dir.path / "out";
     EXPECT_EQ(karst("run " + (dir.path / "w.json").string() + " --out " + out.string() + " --quiet"), 1);
-    const auto stats = nlohmann::json::parse(slurp(out / "stats.json"));
+    const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
     const std::string failure = stats["failure"];
     EXPECT_NE(failure.find("stage 'integrate'"), std::string::npos) << failure;
     EXPECT_NE(failure.find("particle"), std::string::npos);

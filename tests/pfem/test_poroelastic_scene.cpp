@@ -1,5 +1,7 @@
 // Poroelastic-only scenes (issue 4): porous solids with regions for boundary conditions, run by
 // the Biot solver alone. Terzaghi through the shipped scene, scene errors, and the output folder.
+#include "support/files.hpp"
+
 #include "karst/pfem/poroelastic_solid.hpp"
 #include "karst/pfem/porosity.hpp"
 #include "karst/scene/scene_error.hpp"
@@ -17,12 +19,7 @@
 namespace karst {
 namespace {
 
-std::string read_text(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using test::read_text;
 
 const std::string k_scene = std::string(KARST_SOURCE_DIR) + "/scenes/terzaghi_consolidation.json";
 
@@ -108,15 +105,7 @@ TEST(PoroelasticScene, SoakSceneSpreadsAlongTheLayersAndKeepsItsWater) {
 
 TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
     const std::string valid = read_text(k_scene);
-    auto refuse = [](const std::string& text) {
-        try {
-            build_model(parse_scene(text));
-        } catch (const SceneError& e) {
-            return e;
-        }
-        ADD_FAILURE() << "accepted";
-        return SceneError("", "", "");
-    };
+    const auto refuse = test::refuse_scene;
     auto edit = [&](const std::string& from, const std::string& to) {
         std::string s = valid;
         const auto at = s.find(from);

@@ -1,5 +1,6 @@
 // Martin & Moyce (1952), n^2 = 2: the surge front Z = x/a against T = t sqrt(2 g / a) follows the
 // measured curve (../shared/data/martin_moyce_1952_surge_front.csv) within 10 % up to T = 3.
+#include "support/files.hpp"
 #include "support/simulate.hpp"
 
 #include "karst/core/parallel.hpp"
@@ -11,13 +12,6 @@
 
 namespace karst {
 namespace {
-
-std::string read_file(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 /// (T, Z) rows of the measured surge front (a copy of shared/data's table, with its source notes).
 std::vector<std::pair<Real, Real>> martin_moyce() {
@@ -37,7 +31,7 @@ TEST(DamBreak, SurgeFrontFollowsMartinMoyce) {
     const auto data = martin_moyce();
     ASSERT_EQ(data.size(), 15u);
     const Real a = 0.05715, g = 9.81;
-    test::Simulation sim(read_file(std::string(KARST_SOURCE_DIR) + "/scenes/martin_moyce_dam_break.json"));
+    test::Simulation sim(test::read_text(std::string(KARST_SOURCE_DIR) + "/scenes/martin_moyce_dam_break.json"));
     const Real dx = sim.model.dx;
     const Real t_of_T = 1 / std::sqrt(2 * g / a);
     size_t next = 0;

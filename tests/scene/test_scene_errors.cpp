@@ -5,6 +5,8 @@
 #include "karst/scene/schema.hpp"
 #include "karst/sim/model.hpp"
 
+#include "support/files.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -20,16 +22,7 @@ const char* k_valid = R"({
   "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.5, 0.5, 0.5] } } ]
 })";
 
-/// Loads `json` (scene + model) and returns the SceneError it must raise.
-SceneError refuse(const std::string& json) {
-    try {
-        build_model(parse_scene(json));
-    } catch (const SceneError& e) {
-        return e;
-    }
-    ADD_FAILURE() << "scene accepted: " << json;
-    return SceneError("", "", "");
-}
+SceneError refuse(const std::string& json) { return test::refuse_scene(json); }
 
 std::string replace(std::string s, const std::string& from, const std::string& to) {
     const auto at = s.find(from);

@@ -5,6 +5,7 @@
 #include "karst/pfem/tet_mesh.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 
 namespace karst {
@@ -20,6 +21,10 @@ struct BiotMaterial {
     Real lame_lambda() const { return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)); }
     Real shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
     Real drained_bulk_modulus() const { return lame_lambda() + 2 * shear_modulus() / 3; }
+    /// K_s from B = 1 - K_dr / K_s (infinite for B = 1: incompressible grains).
+    Real grain_bulk_modulus() const {
+        return biot_coefficient < 1 ? drained_bulk_modulus() / (1 - biot_coefficient) : std::numeric_limits<Real>::infinity();
+    }
     /// Kim et al.'s coupling strength tau = B^2 M / K_dr: the fixed-strain split needs tau < 1.
     Real coupling_strength() const { return biot_coefficient * biot_coefficient / (storage * drained_bulk_modulus()); }
 };

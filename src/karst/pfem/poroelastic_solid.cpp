@@ -6,7 +6,6 @@
 #include "karst/porous/permeability.hpp"
 #include "karst/sph/kernels.hpp"
 
-#include <limits>
 
 namespace karst {
 
@@ -26,12 +25,14 @@ TetMesh mesh_body(const Model& model, const PorousBody& body, PfemTimings& timin
     return mesh;
 }
 
+/// K0 of the solid's layering (M12), body frame.
+Mat3 body_tensor(const PorousMaterial& m) { return layered_permeability(m.permeability, m.layering_normal, m.layering_ratio); }
+
 BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
     BiotMaterial b;
     b.youngs_modulus = m.youngs_modulus, b.poisson_ratio = m.poisson_ratio, b.biot_coefficient = m.biot_coefficient;
-    const Real grain = m.biot_coefficient < 1 ? b.drained_bulk_modulus() / (1 - m.biot_coefficient) : std::numeric_limits<Real>::infinity();
     // 1/M = phi/K_f + (B - phi)/K_s (method.md §5.3).
-    b.storage = m.porosity / model.scene.poroelastic.fluid_bulk_modulus + (m.biot_coefficient - m.porosity) / grain;
+    b.storage = m.porosity / model.scene.poroelastic.fluid_bulk_modulus + (m.biot_coefficient - m.porosity) / b.grain_bulk_modulus();
     b.fluid_density = model.rho0;
     b.bulk_density = (1 - m.porosity) * m.solid_density + m.porosity * model.rho0;  // saturated
     return b;
@@ -41,9 +42,7 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     BiotProblem p;
     p.material = biot_material(model, solid.material);
     p.gravity = model.scene.gravity;
-    const PorousMaterial& mat = solid.material;
-    const Mat3 K0 = layered_permeability(mat.permeability, mat.layering_normal, mat.layering_ratio);
-    p.mobility.assign(mesh.tet_count(), K0 / mat.darcy_viscosity);
+    p.mobility.assign(mesh.tet_count(), body_tensor(solid.material) / solid.material.darcy_viscosity);
     const Index n = mesh.node_count();
     p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0), p.nodal_force.assign(n, Vec3::Zero());
     // A node is on a region when inside it or within 3/4 of a spacing: the outer particle layer
@@ -107,15 +106,13 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
       m_mesh(mesh_body(model, body, timings)),
       m_solver(make_solver(model, body, m_mesh, timings)),
       m_fields{std::vector<Vec3>(m_mesh.node_count(), Vec3::Zero()), std::vector<Real>(m_mesh.node_count(), 0)} {
-    const BiotMaterial& b = m_solver.problem().material;
-    m_grain_bulk_modulus = b.biot_coefficient < 1 ? b.drained_bulk_modulus() / (1 - b.biot_coefficient) : std::numeric_limits<Real>::infinity();
     for (Index a = 0; a < m_mesh.node_count(); ++a)
         if (m_solver.problem().drained[a]) m_fields.p[a] = m_solver.problem().drained_pressure[a];
     m_assembled_k.assign(m_mesh.tet_count(), m_scene.material.permeability);
 
     // The pore water on the particles (method.md §2, §4.7): the mesh nodes are the particles.
     const PorousMaterial& mat = m_scene.material;
-    m_body_tensor = layered_permeability(mat.permeability, mat.layering_normal, mat.layering_ratio);
+    m_body_tensor = body_tensor(mat);
     m_law.rest_density = model.rho0, m_law.capillary_scale = mat.capillary_pressure;
     m_law.capillary_exponent = mat.capillary_exponent, m_law.pore_stiffness = mat.pore_stiffness;
     m_law.saturation_exponent = mat.saturation_exponent, m_law.darcy_viscosity = mat.darcy_viscosity;
@@ -161,6 +158,11 @@ BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {
     return r;
 }
 
+Real PoroelasticSolid::porosity_at(const NodalStress& stress, Index a) const {
+    return dynamic_porosity(m_scene.material.porosity, stress.volumetric_strain[a], m_fields.p[a],
+                            m_solver.problem().material.grain_bulk_modulus());
+}
+
 void PoroelasticSolid::refresh_permeability() {
     // Feedback (method.md §5.4): M23 porosity and M24 permeability at the nodes, averaged over
     // each tet's nodes, give the mobility of the next call. H is reassembled (and the flow matrix
@@ -169,7 +171,7 @@ void PoroelasticSolid::refresh_permeability() {
     const PorousMaterial& mat = m_scene.material;
     std::vector<Real> k(m_mesh.node_count());
     for (Index a = 0; a < m_mesh.node_count(); ++a) {
-        const Real phi = dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus);
+        const Real phi = porosity_at(stress, a);
         k[a] = kozeny_carman_permeability(mat.permeability, mat.porosity, phi);
         // The particles follow (M12 with R = I): their porosity sets S, their tensor the flow.
         m_particles.porosity[a] = phi;
@@ -197,7 +199,7 @@ void PoroelasticSolid::append_to(MeshFrame& frame) const {
     std::vector<Real> porosity(n), crack(n);
     std::vector<Mat3> permeability(n);
     for (Index a = 0; a < n; ++a) {
-        porosity[a] = dynamic_porosity(mat.porosity, stress.volumetric_strain[a], m_fields.p[a], m_grain_bulk_modulus);
+        porosity[a] = porosity_at(stress, a);
         permeability[a] = (kozeny_carman_permeability(mat.permeability, mat.porosity, porosity[a]) / mat.permeability) * m_body_tensor;
         crack[a] = stress.principal[a][0] / mat.tensile_strength;
     }

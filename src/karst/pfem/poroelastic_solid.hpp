@@ -3,6 +3,7 @@
 // Biot problem its scene entry describes, the fields u and p, and what a frame shows of them.
 #include "karst/io/frame_writer.hpp"
 #include "karst/pfem/biot.hpp"
+#include "karst/pfem/nodal_stress.hpp"
 #include "karst/porous/pore_flow.hpp"
 #include "karst/sim/model.hpp"
 
@@ -45,6 +46,8 @@ public:
 
 private:
     void refresh_permeability();
+    /// M23 at node a from its volumetric strain and Biot pressure.
+    Real porosity_at(const NodalStress& stress, Index a) const;
 
     const PorousSolid& m_scene;
     bool m_feedback, m_pore_water;
@@ -54,7 +57,6 @@ private:
     PorousParticles m_particles;
     NeighbourLists m_pairs;
     std::unique_ptr<PoreFlow> m_flow;
-    Real m_grain_bulk_modulus;  ///< K_s = K_dr / (1 - B), Pa
     TetMesh m_mesh;
     BiotSolver m_solver;
     BiotFields m_fields;

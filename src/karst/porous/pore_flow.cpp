@@ -23,23 +23,28 @@ void PoreFlow::refresh(const PorousParticles& p) {
     });
 }
 
-Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j) const {
-    const Index lo = std::min(i, j), hi = std::max(i, j);
+Real PoreFlow::pair_conductance(const PorousParticles& p, Index lo, Index hi) const {
     if (p.porosity[lo] < k_min_porosity || p.porosity[hi] < k_min_porosity) return 0;  // impermeable (M3)
     const Vec3 x = p.x[lo] - p.x[hi];
     // Different fragments exchange water only in contact, so an open crack does not conduct.
     if (p.fragment[lo] != p.fragment[hi] && x.norm() >= 1.1 * m_spacing) return 0;
-    const Real dphi = m_potential[hi] - m_potential[lo];
-    if (dphi == 0) return 0;
     // M16: the pair weight in the metric of both kernels, calibrated by c_eps.
     const Real F = 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
-    if (F == 0) return 0;
-    // M15: harmonic-mean permeability, relative permeability of the donor (larger Phi).
+    // M15: harmonic-mean permeability.
     const Real kpair = 2 * m_kbar[lo] * m_kbar[hi] / (m_kbar[lo] + m_kbar[hi]);
+    return m_law.rest_density * p.volume[lo] * p.volume[hi] * kpair / (m_law.darcy_viscosity * m_h * m_h) * F;
+}
+
+Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j) const {
+    const Index lo = std::min(i, j), hi = std::max(i, j);
+    const Real dphi = m_potential[hi] - m_potential[lo];
+    if (dphi == 0) return 0;
+    const Real conductance = pair_conductance(p, lo, hi);
+    if (conductance == 0) return 0;
+    // Relative permeability of the donor (larger Phi), upwinded.
     const Index donor = dphi > 0 ? hi : lo;
     const Real kr = std::pow(std::min(m_saturation[donor], Real(1)), m_law.saturation_exponent);
-    const Real into_lo = m_law.rest_density * p.volume[lo] * p.volume[hi] * (kpair * kr / (m_law.darcy_viscosity * m_h * m_h)) *
-                         dphi * F * m_outflow_scale[donor];
+    const Real into_lo = conductance * kr * dphi * m_outflow_scale[donor];
     return i == lo ? into_lo : -into_lo;
 }
 
@@ -65,13 +70,7 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
         const Real stiffness = parallel_max(n, Real(0), [&](Index i) {
             if (p.porosity[i] < k_min_porosity) return Real(0);
             Real sum = 0;
-            neighbours.for_each(i, [&](Index j) {
-                if (p.porosity[j] < k_min_porosity) return;
-                const Vec3 x = p.x[i] - p.x[j];
-                const Real F = 0.5 * (pair_weight(x, m_G[i], m_det_g[i]) + pair_weight(x, m_G[j], m_det_g[j])) * m_calibration;
-                const Real kpair = 2 * m_kbar[i] * m_kbar[j] / (m_kbar[i] + m_kbar[j]);
-                sum += m_law.rest_density * p.volume[i] * p.volume[j] * kpair / (m_law.darcy_viscosity * m_h * m_h) * F;
-            });
+            neighbours.for_each(i, [&](Index j) { sum += pair_conductance(p, std::min(i, j), std::max(i, j)); });
             const Real dphi_dm = m_law.potential_slope(m_saturation[i]) / (m_law.rest_density * p.porosity[i] * p.volume[i]);
             return sum * dphi_dm;
         });

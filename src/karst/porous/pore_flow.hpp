@@ -26,6 +26,9 @@ public:
 private:
     /// Per particle: G (M13), det G, the reference permeability, S and Phi.
     void refresh(const PorousParticles& particles);
+    /// rho0 V_lo V_hi kbar_pair F c_eps / (eta h^2) of M15/M16 (lo < hi), kg/(s Pa) without k_r;
+    /// 0 for impermeable particles and for fragments not in contact.
+    Real pair_conductance(const PorousParticles& particles, Index lo, Index hi) const;
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
     Real pair_flux(const PorousParticles& particles, Index i, Index j) const;
