@@ -85,7 +85,7 @@ TEST(PoroelasticScene, SoakSceneSpreadsAlongTheLayersAndKeepsItsWater) {
     PoroelasticSolid solid(model, model.porous[0], timings);
     auto moments = [&] {
         PointSet points;
-        solid.append_particles_to(points, 0);
+        solid.append_particles_to(points);
         const auto& m = std::find_if(points.arrays.begin(), points.arrays.end(), [](const PointArray& a) { return a.name == "absorbed_mass"; })->values;
         Real total = 0;
         Vec3 mean = Vec3::Zero(), second = Vec3::Zero();

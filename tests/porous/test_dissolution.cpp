@@ -37,7 +37,7 @@ TEST(Dissolution, ConvertsOnlySaturatedHighPorosityParticlesAndConservesMassSolu
     };
     const auto [mass0, solute0, momentum0] = totals();
     std::int64_t next_id = 1;
-    const DissolutionReport r = dissolve(porous, fluid, law, {0.98, 0.6, mf0, dx}, next_id);
+    const DissolutionReport r = dissolve(porous, fluid, {&law, 1}, {{{0.98, 0.6}}, mf0, dx}, next_id);
     EXPECT_EQ(r.dissolved, 2);
     ASSERT_EQ(porous.size(), 2);
     EXPECT_EQ(porous.x[0], Vec3(dx, 0, 0));

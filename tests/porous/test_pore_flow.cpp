@@ -85,7 +85,7 @@ Vec3 variance_growth_ratio(const Mat3& rotation, const Mat3& body_tensor, const 
     Block b = lattice_block(21, rotation, body_tensor);
     set_pulse(b.particles, 2.5 * k_dx);
     const Mat3 before = pulse_moments(b.particles);
-    PoreFlow flow(linear_law(), k_h, k_dx);
+    PoreFlow flow({linear_law()}, k_h, k_dx);
     flow.advance(b.particles, b.neighbours, t);
     const Mat3 after = pulse_moments(b.particles);
     const Mat3 D = k_capillary * world_permeability(k_k0, k_k0, rotation, body_tensor) / (k_phi * k_eta);
@@ -131,7 +131,7 @@ TEST(PoreFlow, PoreWaterIsConservedToRoundOffWithTheLimiterAtWork) {
     // gravity, so the limiter must act for the masses to stay >= 0.
     PoreWaterLaw law;
     law.saturation_exponent = 0;
-    PoreFlow flow(law, k_h, k_dx);
+    PoreFlow flow({law}, k_h, k_dx);
     PoreFlowReport total;
     for (int step = 0; step < 20; ++step) {
         const PoreFlowReport r = flow.advance(p, b.neighbours, 0.01);
@@ -177,7 +177,7 @@ TEST(PoreFlow, SaturatedColumnRelaxesToHydrostaticPorePressure) {
     PorousParticles& p = b.particles;
     const PoreWaterLaw law;  // gravity on, method.md §8.2 defaults
     for (Index i = 0; i < p.size(); ++i) p.absorbed_mass[i] = 1.02 * 1000 * k_phi * p.volume[i];
-    PoreFlow flow(law, k_h, k_dx);
+    PoreFlow flow({law}, k_h, k_dx);
     for (int step = 0; step < 40; ++step) flow.advance(p, b.neighbours, 0.025);
     // Mean pore pressure per layer; below the top layers the pores are over-full (S > 1), and
     // P^p must grow by rho0 g per metre of depth, so that the flow potential is uniform.
@@ -210,7 +210,7 @@ TEST(PoreFlow, CapillaryWettingFrontAdvancesLikeSquareRootOfTime) {
             if (p.x[i][2] < 2 * k_dx) p.absorbed_mass[i] = 1000 * k_phi * p.volume[i];
     };
     refill();
-    PoreFlow flow(law, k_h, k_dx);
+    PoreFlow flow({law}, k_h, k_dx);
     std::vector<Real> times, fronts;
     Real t = 0;
     // Samples once the front spans several particles: before that the lattice's own length

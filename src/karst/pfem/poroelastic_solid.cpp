@@ -4,6 +4,8 @@
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/porosity.hpp"
 #include "karst/porous/permeability.hpp"
+#include "karst/porous/porous_points.hpp"
+#include "karst/sim/porous_materials.hpp"
 #include "karst/sph/kernels.hpp"
 
 
@@ -25,8 +27,8 @@ TetMesh mesh_body(const Model& model, const PorousBody& body, PfemTimings& timin
     return mesh;
 }
 
-/// K0 of the solid's layering (M12), body frame.
-Mat3 body_tensor(const PorousMaterial& m) { return layered_permeability(m.permeability, m.layering_normal, m.layering_ratio); }
+/// Mean of a tet's nodal tensors.
+Mat3 tet_mean(const Tet& t, const std::vector<Mat3>& nodal) { return 0.25 * (nodal[t[0]] + nodal[t[1]] + nodal[t[2]] + nodal[t[3]]); }
 
 BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
     BiotMaterial b;
@@ -38,11 +40,12 @@ BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
     return b;
 }
 
-BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh) {
+BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh, const std::vector<Mat3>& body_tensors) {
     BiotProblem p;
     p.material = biot_material(model, solid.material);
     p.gravity = model.scene.gravity;
-    p.mobility.assign(mesh.tet_count(), body_tensor(solid.material) / solid.material.darcy_viscosity);
+    p.mobility.resize(mesh.tet_count());
+    for (Index e = 0; e < mesh.tet_count(); ++e) p.mobility[e] = tet_mean(mesh.tets[e], body_tensors) / solid.material.darcy_viscosity;
     const Index n = mesh.node_count();
     p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0), p.nodal_force.assign(n, Vec3::Zero());
     // A node is on a region when inside it or within 3/4 of a spacing: the outer particle layer
@@ -84,13 +87,14 @@ void append_arrays(PointSet& into, const PointSet& local) {
     }
 }
 
-BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh& mesh, PfemTimings& timings) {
+BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh& mesh, const std::vector<Mat3>& body_tensors,
+                       PfemTimings& timings) {
     const PoroelasticSettings& pe = model.scene.poroelastic;
     BiotOptions options;
     options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
     options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
     options.polyhedral = pe.mfem_polyhedra;
-    BiotSolver solver(mesh, biot_problem(model, model.scene.porous_solids[body.solid], mesh), options);
+    BiotSolver solver(mesh, biot_problem(model, model.scene.porous_solids[body.solid], mesh, body_tensors), options);
     timings.assembly += solver.seconds_assembly();
     timings.factorisation += solver.seconds_elastic_factorisation();
     return solver;
@@ -103,8 +107,10 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
       m_feedback(model.scene.poroelastic.permeability_feedback),
       m_pore_water(model.scene.poroelastic.pressure_from_pore_water),
       m_h(model.h),
+      m_body_tensors(body_permeabilities(m_scene.material, body.rest_x, model.h)),
+      m_law(pore_water_law(m_scene.material, model.rho0, model.scene.gravity)),
       m_mesh(mesh_body(model, body, timings)),
-      m_solver(make_solver(model, body, m_mesh, timings)),
+      m_solver(make_solver(model, body, m_mesh, m_body_tensors, timings)),
       m_fields{std::vector<Vec3>(m_mesh.node_count(), Vec3::Zero()), std::vector<Real>(m_mesh.node_count(), 0)} {
     for (Index a = 0; a < m_mesh.node_count(); ++a)
         if (m_solver.problem().drained[a]) m_fields.p[a] = m_solver.problem().drained_pressure[a];
@@ -112,30 +118,27 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
 
     // The pore water on the particles (method.md §2, §4.7): the mesh nodes are the particles.
     const PorousMaterial& mat = m_scene.material;
-    m_body_tensor = body_tensor(mat);
-    m_law.rest_density = model.rho0, m_law.capillary_scale = mat.capillary_pressure;
-    m_law.capillary_exponent = mat.capillary_exponent, m_law.pore_stiffness = mat.pore_stiffness;
-    m_law.saturation_exponent = mat.saturation_exponent, m_law.darcy_viscosity = mat.darcy_viscosity;
-    m_law.gravity = model.scene.gravity;
     const Real V0 = model.dx * model.dx * model.dx;
     PorousParticles& p = m_particles;
-    for (const Vec3& x : body.rest_x) {
+    for (size_t i = 0; i < body.rest_x.size(); ++i) {
+        const Vec3& x = body.rest_x[i];
         Real S = mat.initial_saturation;
         for (const WetRegion& w : m_scene.wet_regions)
             if (w.region.signed_distance(x) <= 0) S = w.saturation;
         p.x.push_back(x), p.v.push_back(Vec3::Zero()), p.volume.push_back(V0), p.porosity.push_back(mat.porosity);
         p.absorbed_mass.push_back(S * model.rho0 * mat.porosity * V0);
         p.solid_mass.push_back(mat.solid_density * (1 - mat.porosity) * V0);
-        p.permeability.push_back(m_body_tensor), p.fragment.push_back(body.solid);
+        p.permeability.push_back(m_body_tensors[i]), p.fragment.push_back(body.solid);
     }
-    const Real reach = kernel_reach(m_body_tensor, model.h);
+    Real reach = model.h;
+    for (const Mat3& K : m_body_tensors) reach = std::max(reach, kernel_reach(K, model.h));
     Aabb box;
     for (const Vec3& x : p.x) box.extend(x);
     const UniformGrid grid(box.padded(reach), reach);
     CellRanges cells;
     sort_into_cells(grid, p.x, cells);
     find_neighbours(grid, p.x, cells, true, m_pairs);
-    m_flow = std::make_unique<PoreFlow>(m_law, model.h, model.dx);
+    m_flow = std::make_unique<PoreFlow>(std::vector{m_law}, model.h, model.dx);
 }
 
 BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {
@@ -175,7 +178,7 @@ void PoroelasticSolid::refresh_permeability() {
         k[a] = kozeny_carman_permeability(mat.permeability, mat.porosity, phi);
         // The particles follow (M12 with R = I): their porosity sets S, their tensor the flow.
         m_particles.porosity[a] = phi;
-        m_particles.permeability[a] = (k[a] / mat.permeability) * m_body_tensor;
+        m_particles.permeability[a] = (k[a] / mat.permeability) * m_body_tensors[a];
     }
     std::vector<Real> tet_k(m_mesh.tet_count());
     bool changed = false;
@@ -186,7 +189,8 @@ void PoroelasticSolid::refresh_permeability() {
     }
     if (!changed) return;
     std::vector<Mat3> mobility(m_mesh.tet_count());
-    for (Index e = 0; e < m_mesh.tet_count(); ++e) mobility[e] = (tet_k[e] / (mat.permeability * mat.darcy_viscosity)) * m_body_tensor;
+    for (Index e = 0; e < m_mesh.tet_count(); ++e)
+        mobility[e] = (tet_k[e] / (mat.permeability * mat.darcy_viscosity)) * tet_mean(m_mesh.tets[e], m_body_tensors);
     m_solver.set_mobility(std::move(mobility));
     m_assembled_k = std::move(tet_k);
 }
@@ -200,7 +204,7 @@ void PoroelasticSolid::append_to(MeshFrame& frame) const {
     std::vector<Mat3> permeability(n);
     for (Index a = 0; a < n; ++a) {
         porosity[a] = porosity_at(stress, a);
-        permeability[a] = (kozeny_carman_permeability(mat.permeability, mat.porosity, porosity[a]) / mat.permeability) * m_body_tensor;
+        permeability[a] = (kozeny_carman_permeability(mat.permeability, mat.porosity, porosity[a]) / mat.permeability) * m_body_tensors[a];
         crack[a] = stress.principal[a][0] / mat.tensile_strength;
     }
     PointSet local;
@@ -222,34 +226,9 @@ Real PoroelasticSolid::absorbed_water() const {
     return sum;
 }
 
-void PoroelasticSolid::append_particles_to(PointSet& points, Index fragment) const {
-    const PorousParticles& p = m_particles;
-    const Index n = p.size();
-    std::vector<Real> S(n), phi(n), pore_pressure(n), potential(n);
-    for (Index i = 0; i < n; ++i) {
-        S[i] = m_law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]);
-        pore_pressure[i] = m_law.pore_pressure(S[i]);
-        potential[i] = m_law.flow_potential(S[i], p.x[i]);
-    }
-    // M17: v_p = -(k_r K / (phi eta)) grad Phi, grad Phi = sum_j V_j (Phi_j - Phi_i) grad W_ij.
-    const CubicKernel W(m_h);
-    std::vector<Vec3> velocity(n, Vec3::Zero());
-    for (Index i = 0; i < n; ++i) {
-        Vec3 grad = Vec3::Zero();
-        m_pairs.for_each(i, [&](Index j) { grad += p.volume[j] * (potential[j] - potential[i]) * W.gradient(p.x[i] - p.x[j]); });
-        const Real kr = std::pow(std::min(S[i], Real(1)), m_law.saturation_exponent);
-        velocity[i] = -(kr / (p.porosity[i] * m_law.darcy_viscosity)) * (p.permeability[i] * grad);
-    }
-    PointSet local;
-    local.add_scalar("saturation", S);
-    local.add_scalar("porosity", p.porosity);
-    local.add_scalar("absorbed_mass", p.absorbed_mass);
-    local.add_scalar("pore_pressure", pore_pressure);
-    local.add_vector("pore_velocity", velocity);
-    local.add_integer("fragment", std::vector<std::int64_t>(n, fragment));
-    local.add_symmetric_tensor("permeability", p.permeability);
-    append_arrays(points, local);
-    points.x.insert(points.x.end(), p.x.begin(), p.x.end());
+void PoroelasticSolid::append_particles_to(PointSet& points) const {
+    append_arrays(points, porous_points(m_particles, {&m_law, 1}, m_pairs, m_h));
+    points.x.insert(points.x.end(), m_particles.x.begin(), m_particles.x.end());
 }
 
 }  // namespace karst

@@ -30,7 +30,7 @@ public:
 
     /// The solid's particles with saturation, porosity, absorbed_mass, pore_pressure (M5),
     /// pore_velocity (M17), fragment and permeability (6 components), for porous_NNNN.vtp.
-    void append_particles_to(PointSet& points, Index fragment) const;
+    void append_particles_to(PointSet& points) const;
 
     /// Pore water held by the solid, kg.
     Real absorbed_water() const;
@@ -52,7 +52,7 @@ private:
     const PorousSolid& m_scene;
     bool m_feedback, m_pore_water;
     Real m_h;                   ///< SPH support radius, m
-    Mat3 m_body_tensor;         ///< K0 (M12), m^2
+    std::vector<Mat3> m_body_tensors;  ///< K0 per node (M12), m^2
     PoreWaterLaw m_law;
     PorousParticles m_particles;
     NeighbourLists m_pairs;

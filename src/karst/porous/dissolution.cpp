@@ -14,14 +14,16 @@ Vec3 piece_offset(int piece, Real dx) {
 
 }  // namespace
 
-DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, const PoreWaterLaw& law,
+DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::span<const PoreWaterLaw> laws,
                            const DissolutionSettings& settings, std::int64_t& next_id) {
     DissolutionReport report;
     std::vector<char> keep(porous.size(), 1);
     for (Index i = 0; i < porous.size(); ++i) {
         const Real phi = porous.porosity[i];
-        if (phi < settings.porosity) continue;
-        if (law.saturation(porous.absorbed_mass[i], phi, porous.volume[i]) < settings.saturation) continue;
+        const PoreWaterLaw& law = laws[porous.material_of(i)];
+        const DissolutionThreshold& threshold = settings.thresholds[porous.material_of(i)];
+        if (phi < threshold.porosity) continue;
+        if (law.saturation(porous.absorbed_mass[i], phi, porous.volume[i]) < threshold.saturation) continue;
         keep[i] = 0, ++report.dissolved;
         const Real m = porous.solid_mass[i] + porous.absorbed_mass[i], solute = porous.solid_mass[i];
         const int pieces = m > 2 * settings.fluid_particle_mass ? int(std::ceil(m / settings.fluid_particle_mass)) : 1;

@@ -1,5 +1,6 @@
 #include "karst/porous/pore_flow.hpp"
 
+#include "karst/core/check.hpp"
 #include "karst/core/parallel.hpp"
 #include "karst/porous/anisotropic_kernel.hpp"
 #include "karst/porous/permeability.hpp"
@@ -8,18 +9,21 @@
 
 namespace karst {
 
-PoreFlow::PoreFlow(const PoreWaterLaw& law, Real h, Real spacing)
-    : m_law(law), m_h(h), m_spacing(spacing), m_calibration(pair_weight_calibration()) {}
+PoreFlow::PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing)
+    : m_laws(std::move(laws)), m_h(h), m_spacing(spacing), m_calibration(pair_weight_calibration()) {
+    KARST_CHECK(!m_laws.empty());
+}
 
 void PoreFlow::refresh(const PorousParticles& p) {
     const Index n = p.size();
-    m_G.resize(n), m_det_g.resize(n), m_kbar.resize(n), m_saturation.resize(n), m_potential.resize(n);
+    m_G.resize(n), m_det_g.resize(n), m_mobility.resize(n), m_saturation.resize(n), m_potential.resize(n);
     m_outflow_scale.assign(n, 1);
     parallel_for(n, [&](Index i) {
+        const PoreWaterLaw& l = law(p, i);
         const KernelMetric metric = kernel_metric(p.permeability[i], m_h);
-        m_G[i] = metric.G, m_det_g[i] = metric.det_g, m_kbar[i] = metric.k_ref;
-        m_saturation[i] = p.porosity[i] >= k_min_porosity ? m_law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]) : 0;
-        m_potential[i] = m_law.flow_potential(m_saturation[i], p.x[i]);
+        m_G[i] = metric.G, m_det_g[i] = metric.det_g, m_mobility[i] = metric.k_ref / l.darcy_viscosity;
+        m_saturation[i] = p.porosity[i] >= k_min_porosity ? l.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]) : 0;
+        m_potential[i] = l.flow_potential(m_saturation[i], p.x[i]);
     });
 }
 
@@ -30,9 +34,9 @@ Real PoreFlow::pair_conductance(const PorousParticles& p, Index lo, Index hi) co
     if (p.fragment[lo] != p.fragment[hi] && x.norm() >= 1.1 * m_spacing) return 0;
     // M16: the pair weight in the metric of both kernels, calibrated by c_eps.
     const Real F = 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
-    // M15: harmonic-mean permeability.
-    const Real kpair = 2 * m_kbar[lo] * m_kbar[hi] / (m_kbar[lo] + m_kbar[hi]);
-    return m_law.rest_density * p.volume[lo] * p.volume[hi] * kpair / (m_law.darcy_viscosity * m_h * m_h) * F;
+    // M15: harmonic mean of the mobilities k / eta (of the permeabilities for one material).
+    const Real mobility = 2 * m_mobility[lo] * m_mobility[hi] / (m_mobility[lo] + m_mobility[hi]);
+    return law(p, lo).rest_density * p.volume[lo] * p.volume[hi] * mobility / (m_h * m_h) * F;
 }
 
 Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j) const {
@@ -43,9 +47,38 @@ Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j) const {
     if (conductance == 0) return 0;
     // Relative permeability of the donor (larger Phi), upwinded.
     const Index donor = dphi > 0 ? hi : lo;
-    const Real kr = std::pow(std::min(m_saturation[donor], Real(1)), m_law.saturation_exponent);
+    const Real kr = std::pow(std::min(m_saturation[donor], Real(1)), law(p, donor).saturation_exponent);
     const Real into_lo = conductance * kr * dphi * m_outflow_scale[donor];
     return i == lo ? into_lo : -into_lo;
+}
+
+Real PoreFlow::fluid_conductance(const PorousParticles& p, Index k, const Vec3& x, Real m) const {
+    if (p.porosity[k] < k_min_porosity) return 0;
+    // M15/M16 for a fluid-porous pair: rho0 V_k (m / rho0) chi k_porous F(x, G_porous) / (eta h^2).
+    const Real F = pair_weight(x, m_G[k], m_det_g[k]) * m_calibration;
+    return p.volume[k] * m * law(p, k).absorption_factor * m_mobility[k] / (m_h * m_h) * F;
+}
+
+void PoreFlow::fluid_pair_fluxes(const PorousParticles& p, const FluidExchange& fluid) {
+    const NeighbourLists& lists = *fluid.porous_fluid;
+    const int cap = lists.capacity;
+    m_fluid_flux.resize(size_t(p.size()) * cap);
+    parallel_for(p.size(), [&](Index k) {
+        Real* flux = m_fluid_flux.data() + k * cap;
+        int s = 0;
+        lists.for_each(k, [&](Index f) {
+            const Real dphi = m_fluid_potential[f] - m_potential[k];
+            Real q = 0;
+            const Real c = dphi == 0 ? 0 : fluid_conductance(p, k, (*fluid.x)[f] - p.x[k], (*fluid.mass)[f]);
+            if (c > 0) {
+                if (dphi > 0) q = c * dphi * m_fluid_donor_scale[f];  // the fluid gives, k_r = 1 (S = 1)
+                else  // the porous particle gives back, k_r of its own S, to a fluid receiver
+                    q = c * std::pow(std::min(m_saturation[k], Real(1)), law(p, k).saturation_exponent) * dphi *
+                        m_outflow_scale[k] * m_fluid_receiver_scale[f];
+            }
+            flux[s++] = q;
+        });
+    });
 }
 
 void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours, std::vector<Real>& rate) {
@@ -58,47 +91,108 @@ void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours,
     });
 }
 
-PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neighbours, Real dt) {
+PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neighbours, Real dt, FluidExchange* fluid) {
     PoreFlowReport report;
     const Index n = p.size();
-    std::vector<Real> rate(n), outflow(n);
+    const Index nf = fluid ? Index(fluid->mass->size()) : 0;
+    const int cap = fluid ? fluid->porous_fluid->capacity : 0;
+    auto for_each_fluid_pair = [&](const auto& f) {  // serial, in (porous, slot) order: deterministic
+        if (!fluid) return;
+        for (Index k = 0; k < n; ++k) {
+            int s = 0;
+            fluid->porous_fluid->for_each(k, [&](Index j) { f(k, j, k * cap + s++); });
+        }
+    };
+    if (fluid) {
+        // Phi_f = max(p, 0) - rho0 g.x (M6); the fluid pressure is this step's and stays fixed.
+        m_fluid_potential.resize(nf);
+        const PoreWaterLaw& l = m_laws[0];
+        parallel_for(nf, [&](Index f) {
+            m_fluid_potential[f] = std::max((*fluid->pressure)[f], Real(0)) - l.rest_density * l.gravity.dot((*fluid->x)[f]);
+        });
+        m_fluid_transfer.assign(size_t(n) * cap, 0);
+    }
+    std::vector<Real> rate(n), outflow(n), fluid_out(nf), fluid_in(nf);
     Real remaining = dt;
     while (remaining > 0) {
         refresh(p);
+        m_fluid_donor_scale.assign(nf, 1), m_fluid_receiver_scale.assign(nf, 1);
         // Sub-step limit (§4.7.5): explicit diffusion is stable for dt sum_j c_ij dPhi_i/dm_i <= 1;
-        // half of that, with k_r = 1 as its upper bound.
+        // half of that, with k_r = 1 as its upper bound. A fluid particle's Phi does not depend on
+        // its mass, so only porous particles limit the step.
         const Real stiffness = parallel_max(n, Real(0), [&](Index i) {
             if (p.porosity[i] < k_min_porosity) return Real(0);
             Real sum = 0;
             neighbours.for_each(i, [&](Index j) { sum += pair_conductance(p, std::min(i, j), std::max(i, j)); });
-            const Real dphi_dm = m_law.potential_slope(m_saturation[i]) / (m_law.rest_density * p.porosity[i] * p.volume[i]);
-            return sum * dphi_dm;
+            if (fluid)
+                fluid->porous_fluid->for_each(i, [&](Index f) {
+                    sum += fluid_conductance(p, i, (*fluid->x)[f] - p.x[i], (*fluid->mass)[f]);
+                });
+            const PoreWaterLaw& l = law(p, i);
+            return sum * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
         });
         const Real limit = stiffness > 0 ? 0.5 / stiffness : remaining;
         const Real steps = std::ceil(remaining / limit - 1e-12);
         const Real h_sub = remaining / std::max(Real(1), steps);
 
-        // Donor limiter (Zalesak-style): a donor may not give more than it has this sub-step;
-        // all its outgoing pair fluxes are scaled alike, and each stays antisymmetric.
+        // Donor limiter (Zalesak-style): a donor may not give more than it has this sub-step, and
+        // a fluid receiver may not fill beyond m_f0; all of a limited particle's outgoing (or
+        // incoming) pair fluxes are scaled alike, and each stays antisymmetric.
+        if (fluid) fluid_pair_fluxes(p, *fluid);
         parallel_for(n, [&](Index i) {
             Real out = 0;
             neighbours.for_each(i, [&](Index j) { out += std::max(-pair_flux(p, i, j), Real(0)); });
+            if (fluid)
+                for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) out += std::max(-m_fluid_flux[i * cap + s], Real(0));
             outflow[i] = out;
+        });
+        std::fill(fluid_out.begin(), fluid_out.end(), 0), std::fill(fluid_in.begin(), fluid_in.end(), 0);
+        for_each_fluid_pair([&](Index, Index f, size_t slot) {
+            const Real q = m_fluid_flux[slot];
+            (q > 0 ? fluid_out[f] : fluid_in[f]) += std::abs(q);
         });
         for (Index i = 0; i < n; ++i)
             if (outflow[i] * h_sub > p.absorbed_mass[i]) {
                 m_outflow_scale[i] = p.absorbed_mass[i] / (outflow[i] * h_sub);
                 ++report.limited_donors;
             }
+        if (fluid) {
+            for (Index f = 0; f < nf; ++f) {
+                const Real mass = (*fluid->mass)[f], water = mass - (*fluid->solute)[f];
+                const Real room = std::max(fluid->full_mass - mass, Real(0));
+                if (fluid_out[f] * h_sub > water) {
+                    m_fluid_donor_scale[f] = std::max(water, Real(0)) / (fluid_out[f] * h_sub);
+                    ++report.limited_donors;
+                }
+                if (fluid_in[f] * h_sub > room) m_fluid_receiver_scale[f] = room / (fluid_in[f] * h_sub);
+            }
+            fluid_pair_fluxes(p, *fluid);  // again, with the scales
+        }
         parallel_for(n, [&](Index i) {
             Real sum = 0;
             neighbours.for_each(i, [&](Index j) { sum += pair_flux(p, i, j); });
+            if (fluid)
+                for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) sum += m_fluid_flux[i * cap + s];
             rate[i] = sum;
         });
         for (Index i = 0; i < n; ++i) p.absorbed_mass[i] = std::max(p.absorbed_mass[i] + h_sub * rate[i], Real(0));
+        for_each_fluid_pair([&](Index, Index f, size_t slot) {
+            const Real dm = h_sub * m_fluid_flux[slot];
+            (*fluid->mass)[f] -= dm;
+            m_fluid_transfer[slot] += dm;
+            report.absorbed += dm;
+        });
         remaining -= h_sub;
         if (remaining < 1e-12 * dt) remaining = 0;
         ++report.substeps;
+    }
+    if (fluid) {
+        // The porous particle that received most of each fluid particle's water (§4.7.3).
+        fluid->main_receiver.assign(nf, -1);
+        std::vector<Real> most(nf, 0);
+        for_each_fluid_pair([&](Index k, Index f, size_t slot) {
+            if (m_fluid_transfer[slot] > most[f]) most[f] = m_fluid_transfer[slot], fluid->main_receiver[f] = k;
+        });
     }
     return report;
 }

@@ -1,42 +1,71 @@
 #pragma once
-// Conservative pore-water transport between porous particles (method.md §4.7, M14-M16): one
-// antisymmetric Darcy flux per pair in the metric of the anisotropic kernel, with the donor
-// limiter and sub-steps of §4.7.5. Total pore water is conserved to round-off.
+// Conservative pore-water transport (method.md §4.7, M14-M16): one antisymmetric Darcy flux per
+// pair in the metric of the anisotropic kernel, between porous particles and between porous
+// and fluid particles (absorption and back-flow, §4.7.3), with the donor limiter and sub-steps
+// of §4.7.5. Total water is conserved to round-off.
 #include "karst/porous/pore_water.hpp"
 #include "karst/sph/neighbour_grid.hpp"
+
+#include <span>
 
 namespace karst {
 
 struct PoreFlowReport {
     int substeps = 0;
     Index limited_donors = 0;  ///< donors whose outflow the limiter scaled (summed over sub-steps)
+    Real absorbed = 0;         ///< net water from fluid into porous particles, kg
 };
 
-/// Transport over dt. `neighbours` lists, for every particle, the particles within the largest
-/// kernel reach (kernel_reach of M13); `h` is the isotropic support radius.
+/// The fluid particles taking part in the pore flow (§4.7.3): each is a pore-water donor or
+/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6), volume m / rho0.
+struct FluidExchange {
+    const std::vector<Vec3>* x = nullptr;          ///< fluid positions, m
+    std::vector<Real>* mass = nullptr;             ///< fluid masses, kg (changed)
+    const std::vector<Real>* solute = nullptr;     ///< solute masses, kg: water is m - m_sol
+    const std::vector<Real>* pressure = nullptr;   ///< PCISPH pressure of this step, Pa
+    const NeighbourLists* porous_fluid = nullptr;  ///< per porous particle: fluid within kernel reach
+    Real full_mass = 0;                            ///< m_f0: no transfer fills a fluid particle beyond it, kg
+    /// Out, per fluid particle: the porous particle that received most of its water this step
+    /// (-1 when none), for the deletion of drained particles.
+    std::vector<Index> main_receiver;
+};
+
+/// Transport over dt. `neighbours` lists, for every porous particle, the porous particles
+/// within the largest kernel reach (kernel_reach of M13); `h` is the isotropic support radius.
 class PoreFlow {
 public:
-    /// `h` is the isotropic support radius, `spacing` the particle spacing dx.
-    PoreFlow(const PoreWaterLaw& law, Real h, Real spacing);
-    PoreFlowReport advance(PorousParticles& particles, const NeighbourLists& neighbours, Real dt);
+    /// `laws` per material (PorousParticles::material), `h` the isotropic support radius,
+    /// `spacing` the particle spacing dx.
+    PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing);
+    PoreFlowReport advance(PorousParticles& particles, const NeighbourLists& neighbours, Real dt,
+                           FluidExchange* fluid = nullptr);
 
     /// Net pore-water rate into each particle (kg/s) at the current state, for tests.
     void rates(const PorousParticles& particles, const NeighbourLists& neighbours, std::vector<Real>& rate);
 
 private:
-    /// Per particle: G (M13), det G, the reference permeability, S and Phi.
+    const PoreWaterLaw& law(const PorousParticles& p, Index i) const { return m_laws[p.material_of(i)]; }
+    /// Per particle: G (M13), det G, mobility k_ref / eta, S and Phi.
     void refresh(const PorousParticles& particles);
-    /// rho0 V_lo V_hi kbar_pair F c_eps / (eta h^2) of M15/M16 (lo < hi), kg/(s Pa) without k_r;
+    /// rho0 V_lo V_hi (k/eta)_pair F c_eps / h^2 of M15/M16 (lo < hi), kg/(s Pa) without k_r;
     /// 0 for impermeable particles and for fragments not in contact.
     Real pair_conductance(const PorousParticles& particles, Index lo, Index hi) const;
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
     Real pair_flux(const PorousParticles& particles, Index i, Index j) const;
+    /// Conductance of porous k with a fluid particle of mass m at offset x (M15, fluid pair).
+    Real fluid_conductance(const PorousParticles& particles, Index k, const Vec3& x, Real m) const;
+    /// Flux into each porous particle from each listed fluid particle (kg/s), in the slots of
+    /// fluid.porous_fluid, with the current limiter scales.
+    void fluid_pair_fluxes(const PorousParticles& particles, const FluidExchange& fluid);
 
-    PoreWaterLaw m_law;
+    std::vector<PoreWaterLaw> m_laws;
     Real m_h, m_spacing, m_calibration;
     std::vector<Mat3> m_G;
-    std::vector<Real> m_det_g, m_kbar /* k_ref of KernelMetric */, m_saturation, m_potential, m_outflow_scale;
+    std::vector<Real> m_det_g, m_mobility, m_saturation, m_potential, m_outflow_scale;
+    std::vector<Real> m_fluid_potential;                 ///< per fluid particle, Pa
+    std::vector<Real> m_fluid_donor_scale, m_fluid_receiver_scale;  ///< per fluid particle, limiter
+    std::vector<Real> m_fluid_flux, m_fluid_transfer;    ///< per porous-fluid slot: kg/s, kg this step
 };
 
 }  // namespace karst

@@ -9,8 +9,9 @@
 
 namespace karst {
 
-/// Porous particles as structure-of-arrays (the pore side; fragments come with issue 3's rigid
-/// bodies). Mass of pore water m_p is the conserved quantity.
+/// Porous particles as structure-of-arrays (method.md §2). Mass of pore water m_p is the
+/// conserved quantity. `rest` and `material` may stay empty for a set of one material that
+/// belongs to no rigid fragment (the poroelastic-only solver, unit tests).
 struct PorousParticles {
     std::vector<Vec3> x;               ///< world position, m
     std::vector<Real> volume;          ///< bulk volume V, m^3
@@ -20,11 +21,16 @@ struct PorousParticles {
     std::vector<Vec3> v;               ///< world velocity (from the fragment), m/s
     std::vector<Mat3> permeability;    ///< world tensor K (M12), m^2
     std::vector<Index> fragment;       ///< pairs in different fragments exchange only in contact
+    std::vector<Vec3> rest;            ///< X, position in the fragment's body frame about its centre, m
+    std::vector<Index> material;       ///< index of the material's PoreWaterLaw (the scene's solid)
+    std::vector<Mat3> body_permeability;  ///< K0 in the body frame (M12), m^2
     Index size() const { return Index(x.size()); }
+    Index material_of(Index i) const { return material.empty() ? 0 : material[i]; }
     /// Keeps the particles whose flag is set, in order.
     void keep(const std::vector<char>& flag) {
         keep_flagged(x, flag), keep_flagged(volume, flag), keep_flagged(porosity, flag), keep_flagged(absorbed_mass, flag);
         keep_flagged(solid_mass, flag), keep_flagged(v, flag), keep_flagged(permeability, flag), keep_flagged(fragment, flag);
+        keep_flagged(rest, flag), keep_flagged(material, flag), keep_flagged(body_permeability, flag);
     }
 };
 
@@ -40,6 +46,7 @@ struct PoreWaterLaw {
     Real tait_exponent = 7;        ///< gamma of M5
     Real saturation_exponent = 2;  ///< beta: k_r = S^beta
     Real darcy_viscosity = 0.1;    ///< eta, Pa s
+    Real absorption_factor = 1;    ///< chi_abs of M15: scales fluid-porous pairs
     Vec3 gravity{0, 0, -9.81};     ///< m/s^2
 
     /// M3: S = m_p / (rho0 phi V).

@@ -42,4 +42,24 @@ Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbo
     return pairs / 2;
 }
 
+Index add_wall_contact_forces(const PorousParticles& p, const NeighbourLists& walls, const std::vector<Vec3>& wall_x,
+                              const ContactLaw& law, std::vector<Vec3>& force) {
+    std::vector<Index> touching(p.size(), 0);
+    parallel_for(p.size(), [&](Index i) {
+        Vec3 sum = Vec3::Zero();
+        walls.for_each(i, [&](Index k) {
+            const Vec3 x = p.x[i] - wall_x[k];
+            const Real r = x.norm();
+            if (r >= law.rest_distance || r == 0) return;
+            const Vec3 n = x / r;
+            sum += (law.stiffness * (law.rest_distance - r) - law.damping * p.v[i].dot(n)) * n;
+            ++touching[i];
+        });
+        force[i] += sum;
+    });
+    Index pairs = 0;
+    for (Index t : touching) pairs += t;
+    return pairs;
+}
+
 }  // namespace karst

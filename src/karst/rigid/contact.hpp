@@ -18,8 +18,13 @@ struct ContactLaw {
 };
 
 /// Adds the contact forces (N) into `force` (one per particle); `neighbours` lists particles
-/// within d0 (any fragment). Returns the number of touching pairs.
+/// within at least d0 (any fragment). Returns the number of touching pairs.
 Index add_contact_forces(const PorousParticles& particles, const NeighbourLists& neighbours, const ContactLaw& law,
                          std::vector<Vec3>& force);
+
+/// The same springs against static wall particles at `wall_x` (the walls take no reaction);
+/// `walls` lists, per porous particle, wall particles within at least d0. Returns the touching pairs.
+Index add_wall_contact_forces(const PorousParticles& particles, const NeighbourLists& walls, const std::vector<Vec3>& wall_x,
+                              const ContactLaw& law, std::vector<Vec3>& force);
 
 }  // namespace karst

@@ -8,7 +8,7 @@ namespace karst {
 
 Vec3 Fragment::angular_velocity() const { return world_inertia().inverse() * angular_momentum; }
 
-Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, std::vector<Vec3>& body_positions) {
+Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, std::vector<Vec3>& body_positions, Real spacing) {
     KARST_CHECK(x.size() == mass.size() && !x.empty());
     Fragment f;
     Vec3 moment = Vec3::Zero();
@@ -20,7 +20,7 @@ Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, s
     for (size_t k = 0; k < x.size(); ++k) {
         const Vec3 X = x[k] - f.centre;
         body_positions[k] = X;
-        f.body_inertia += mass[k] * (X.squaredNorm() * Mat3::Identity() - X * X.transpose());
+        f.body_inertia += member_inertia(mass[k], X, spacing);
     }
     return f;
 }

@@ -30,10 +30,18 @@ struct Fragment {
     Vec3 point_velocity(const Vec3& x) const { return velocity + angular_velocity().cross(x - centre); }
 };
 
-/// Mass, centre and body inertia I0 = sum m (|X|^2 I - X X^T) of members with masses `mass` at
-/// world positions `x`, with the fragment at rest orientation (R = I). Returns the fragment at
-/// rest, and writes each member's body-frame position X = x - c.
-Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, std::vector<Vec3>& body_positions);
+/// Mass, centre and body inertia I0 = sum m (|X|^2 I - X X^T + s^2/6 I) of members with masses
+/// `mass` at world positions `x`, with the fragment at rest orientation (R = I); `spacing` s is
+/// the edge of the cube each member fills (its own inertia m s^2/6 keeps I0 invertible for one
+/// or a line of members). Returns the fragment at rest, and writes each member's body-frame
+/// position X = x - c.
+Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, std::vector<Vec3>& body_positions,
+                          Real spacing = 0);
+
+/// One member's share of I0: m (|X|^2 I - X X^T + s^2/6 I).
+inline Mat3 member_inertia(Real m, const Vec3& X, Real spacing) {
+    return m * ((X.squaredNorm() + spacing * spacing / 6) * Mat3::Identity() - X * X.transpose());
+}
 
 /// One step (§4.5): v += dt F / M, c += dt v; L += dt tau, omega = I_w^-1 L,
 /// q <- normalise(q + dt/2 (0, omega) q). Anchored fragments do not move.

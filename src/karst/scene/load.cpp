@@ -105,6 +105,12 @@ Scene parse_scene(const std::string& text) {
         mat.capillary_pressure = m["capillary_pressure"], mat.capillary_exponent = m["capillary_exponent"];
         mat.pore_stiffness = m["pore_stiffness"], mat.saturation_exponent = m["saturation_exponent"];
         mat.initial_saturation = m["initial_saturation"];
+        mat.dissolution_porosity = m["dissolution_porosity"], mat.dissolution_saturation = m["dissolution_saturation"];
+        mat.absorption_factor = m["absorption_factor"];
+        const std::string layering = j["layering"]["kind"];
+        mat.layering = layering == "fibre" ? PorousMaterial::Layering::Fibre
+                     : layering == "from_geometry" ? PorousMaterial::Layering::FromGeometry : PorousMaterial::Layering::Bedding;
+        solid.anchored = j["anchored"], solid.velocity = vec3(j["velocity"]), solid.angular_velocity = vec3(j["angular_velocity"]);
         mat.layering_normal = vec3(j["layering"]["normal"]), mat.layering_ratio = j["layering"]["ratio"];
         if (mat.layering_normal.norm() < 1e-6)
             throw SceneError(solid.path + "/layering/normal", "a non-zero direction", "[0, 0, 0]");

@@ -61,8 +61,13 @@ struct PorousMaterial {
     Real pore_stiffness = 1.4e4;      ///< k^p, Pa
     Real saturation_exponent = 2;     ///< beta
     Real initial_saturation = 0;
-    Vec3 layering_normal{0, 0, 1};
-    Real layering_ratio = 1;          ///< k along / k across the layers
+    enum class Layering { Bedding, Fibre, FromGeometry };
+    Layering layering = Layering::Bedding;
+    Vec3 layering_normal{0, 0, 1};    ///< bedding normal, or fibre tangent
+    Real layering_ratio = 1;          ///< k along / k across the layers (fibres)
+    Real dissolution_porosity = 0.6;  ///< phi_diss (method.md §4.8)
+    Real dissolution_saturation = 0.98;  ///< S_diss
+    Real absorption_factor = 1;       ///< chi_abs of M15
 };
 
 struct WetRegion {
@@ -83,6 +88,9 @@ struct Constraint {
 
 struct PorousSolid {
     Shape shape;
+    bool anchored = true;                     ///< else a free rigid fragment (method.md §4.5)
+    Vec3 velocity = Vec3::Zero();             ///< initial, m/s
+    Vec3 angular_velocity = Vec3::Zero();     ///< initial, rad/s
     PorousMaterial material;
     std::vector<Constraint> constraints;
     std::vector<WetRegion> wet_regions;

@@ -97,12 +97,21 @@ std::vector<KeySpec> make_schema() {
             "Thickness of the particle skin, in particle layers. One layer lets fast particles slip through between steps; two is the safe default."),
 
         key("/porous_solids", T::ObjectArray, "", any(), json::array(),
-            "Porous solids (method.md §2, §5): particles on the scene lattice, meshed into tetrahedra "
-            "(PFEM) for the Biot poroelastic solver. Without fluid blocks a scene is poroelastic-only: "
-            "the Biot solver runs by itself with /poroelastic/time_step."),
+            "Porous solids (method.md §2, §4.5-4.8): particles on the scene lattice. With fluid blocks, or when a "
+            "solid is free, each solid is a rigid fragment coupled two-way with the fluid (Akinci boundary), "
+            "absorbing, carrying and releasing water and dissolving into muddy fluid. Without fluid blocks and "
+            "with every solid anchored, the scene is poroelastic-only: the solids are meshed into tetrahedra "
+            "(PFEM) and the Biot solver runs by itself with /poroelastic/time_step."),
         required("/porous_solids/[]/shape", T::Shape, "", any(), "Geometry of the solid."),
+        key("/porous_solids/[]/anchored", T::Bool, "", any(), true,
+            "true: the solid stays put (a rock on the ground); false: a free rigid body (method.md §4.5) "
+            "moved by gravity, the fluid and contact with walls and other solids."),
+        key("/porous_solids/[]/velocity", T::Vec3, "m/s", closed(-1e3, 1e3), zero3, "Initial velocity of a free solid."),
+        key("/porous_solids/[]/angular_velocity", T::Vec3, "rad/s", closed(-1e4, 1e4), zero3,
+            "Initial angular velocity of a free solid about its centre of mass."),
         key("/porous_solids/[]/material", T::Object, "", any(), json::object(), "Material of the solid."),
-        key("/porous_solids/[]/material/porosity", T::Number, "", closed(0.01, 0.95), 0.3, "Porosity phi0."),
+        key("/porous_solids/[]/material/porosity", T::Number, "", closed(0, 0.95), 0.3,
+            "Porosity phi0. Below 1e-4 the solid is impermeable (M3): it takes no water, e.g. a floating box."),
         key("/porous_solids/[]/material/permeability", T::Number, "m^2", closed(1e-25, 1e-3), 2e-8,
             "Intrinsic permeability k0 (scene-scaled default, method.md §8.2)."),
         key("/porous_solids/[]/material/darcy_viscosity", T::Number, "Pa s", closed(1e-6, 1e6), 0.1,
@@ -127,12 +136,23 @@ std::vector<KeySpec> make_schema() {
             "Exponent beta of the relative permeability k_r = S^beta."),
         key("/porous_solids/[]/material/initial_saturation", T::Number, "", closed(0, 1.2), 0.0,
             "Saturation S at t = 0 outside the wet regions."),
+        key("/porous_solids/[]/material/dissolution_porosity", T::Number, "", closed(0, 1), 0.6,
+            "phi_diss of method.md §4.8: particles at least this porous dissolve once saturated."),
+        key("/porous_solids/[]/material/dissolution_saturation", T::Number, "", closed(0.5, 2), 0.98,
+            "S_diss of method.md §4.8."),
+        key("/porous_solids/[]/material/absorption_factor", T::Number, "", closed(0, 1e3), 1.0,
+            "chi_abs of M15: scales the permeability of fluid-porous pairs (how fast the surface absorbs)."),
         key("/porous_solids/[]/layering", T::Object, "", any(), json::object(),
-            "Bedding planes of a layered rock (M12): permeability ratio along / across the layers."),
+            "Layering of the permeability (M12): ratio along / across bedding planes or a fibre axis."),
+        key("/porous_solids/[]/layering/kind", T::Enum, "", any(), "bedding",
+            "bedding: planes with the given normal; fibre: fibres along the given axis (normal is read as the "
+            "fibre tangent, K0 = k_perp I + (k_par - k_perp) t t^T); from_geometry: bedding planes whose normal is, "
+            "per particle, the direction of least spread of its neighbourhood (weighted PCA, M28).",
+            {"bedding", "fibre", "from_geometry"}),
         key("/porous_solids/[]/layering/normal", T::Vec3, "", closed(-1, 1), json::array({0.0, 0.0, 1.0}),
-            "Bedding-plane normal in the solid's frame."),
+            "Bedding-plane normal (or fibre tangent) in the solid's frame."),
         key("/porous_solids/[]/layering/ratio", T::Number, "", closed(0.01, 100), 1.0,
-            "k along the layers / k across them (1: isotropic); det K stays k0^3."),
+            "k along the layers (fibres) / k across them (1: isotropic); det K stays k0^3."),
         key("/porous_solids/[]/wet_regions", T::ObjectArray, "", any(), json::array(),
             "Regions of the solid that start wet."),
         required("/porous_solids/[]/wet_regions/[]/region", T::Shape, "", any(), "Where the solid starts wet."),

@@ -1,7 +1,9 @@
 #include "karst/sim/model.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/porous/permeability.hpp"
 #include "karst/scene/scene_error.hpp"
+#include "karst/sim/porous_materials.hpp"
 
 #include <fmt/format.h>
 
@@ -173,6 +175,22 @@ void compute_wall_volumes(Model& m, const std::vector<int>& layers) {
     });
 }
 
+/// Per-material laws, K0 per particle, the pore-flow grid and the porous Akinci calibration.
+void set_up_porous_materials(Model& m) {
+    Real reach = m.h;
+    for (PorousBody& body : m.porous) {
+        const PorousSolid& solid = m.scene.porous_solids[body.solid];
+        body.body_permeability = body_permeabilities(solid.material, body.rest_x, m.h);
+        for (const Mat3& K : body.body_permeability) reach = std::max(reach, kernel_reach(K, m.h));
+    }
+    for (const PorousSolid& solid : m.scene.porous_solids) {
+        m.pore_laws.push_back(pore_water_law(solid.material, m.rho0, m.scene.gravity));
+        m.dissolution.push_back({solid.material.dissolution_saturation, solid.material.dissolution_porosity});
+    }
+    m.porous_grid = UniformGrid(m.domain, reach);
+    m.porous_gamma = akinci_calibration(m.kernel, m.dx, m.rho0, m.particle_mass, 4);
+}
+
 }  // namespace
 
 Model build_model(const Scene& scene) {
@@ -207,6 +225,7 @@ Model build_model(const Scene& scene) {
                                  fmt::format("a particle outside it at {}", fmt::streamed(x.transpose())));
     m.grid = UniformGrid(m.domain, m.h);
     compute_wall_volumes(m, wall_layers);
+    set_up_porous_materials(m);
     return m;
 }
 

@@ -3,6 +3,8 @@
 // static wall particles, their Akinci volumes and their cell-sorted layout. Built once from a
 // Scene; all geometry checks that refuse a scene happen here, before simulating.
 #include "karst/core/types.hpp"
+#include "karst/porous/dissolution.hpp"
+#include "karst/porous/pore_water.hpp"
 #include "karst/scene/scene.hpp"
 #include "karst/sph/kernels.hpp"
 #include "karst/sph/neighbour_grid.hpp"
@@ -19,11 +21,11 @@ struct WallParticles {
     Index size() const { return Index(x.size()); }
 };
 
-/// The particles of one porous solid at rest (method.md §2); issue 3 gives them their pore state
-/// and fragment dynamics. The PFEM mesh is built on rest_x.
+/// The particles of one porous solid at rest (method.md §2). The PFEM mesh is built on rest_x.
 struct PorousBody {
     Index solid = 0;              ///< index into scene.porous_solids
     std::vector<Vec3> rest_x;     ///< (n), m
+    std::vector<Mat3> body_permeability;  ///< (n) K0 (M12 / M28), m^2
 };
 
 struct Model {
@@ -43,6 +45,17 @@ struct Model {
     std::vector<Vec3> initial_v;  ///< m/s
     std::vector<Real> initial_concentration;  ///< C = m_sol / m
     std::vector<PorousBody> porous;
+    /// Per material (= per scene solid): the pore-water law and when it dissolves.
+    std::vector<PoreWaterLaw> pore_laws;
+    std::vector<DissolutionThreshold> dissolution;
+    UniformGrid porous_grid;      ///< cell = the longest porous kernel reach (M13), at least h
+    Real porous_gamma = 1;        ///< Akinci calibration of a thick boundary, for porous Psi (§4.1)
+    /// Porous solids run coupled with the fluid as rigid fragments; else they are poroelastic-only.
+    bool coupled() const { return !porous.empty() && (!initial_x.empty() || any_free_solid()); }
+    bool any_free_solid() const {
+        for (const PorousSolid& s : scene.porous_solids) if (!s.anchored) return true;
+        return false;
+    }
 
     /// M8: delta = rho0^2 / (2 dt^2 m^2 (|sum grad W|^2 + sum |grad W|^2)), in Pa per kg/m^3.
     Real pcisph_delta(Real dt) const {

@@ -12,6 +12,7 @@ struct ProgressInfo {
     double mipps = 0;                ///< million particle-steps per second
     double eta_seconds = 0;          ///< wall-clock seconds left
     long long particles = 0;
+    double absorbed_kg = -1;         ///< water soaked into porous solids so far; < 0: no porous solids
 };
 
 class ProgressLine {

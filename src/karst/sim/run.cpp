@@ -2,7 +2,10 @@
 
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
+#include "karst/coupling/porous_boundary_volumes.hpp"
+#include "karst/coupling/porous_neighbours.hpp"
 #include "karst/io/frame_writer.hpp"
+#include "karst/porous/porous_points.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
@@ -21,11 +24,27 @@ namespace karst {
 
 namespace {
 
-Real total_mass(const FluidParticles& f) {
-    return deterministic_sum(f.size(), Real(0), [&](Index i) { return f.mass[i]; });
+/// The conserved totals (method.md §4.7-4.8): water is the fluid's mass less its solute plus
+/// the pore water; grains are the solute plus the porous particles' solid mass.
+struct MassTotals {
+    Real water = 0, solute = 0, absorbed = 0, grains = 0;
+};
+
+MassTotals mass_totals(const State& s) {
+    const FluidParticles& f = s.fluid;
+    const PorousParticles& p = s.porous.particles;
+    MassTotals t;
+    t.solute = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.solute[i]; });
+    t.absorbed = deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
+    t.water = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.mass[i] - f.solute[i]; }) + t.absorbed;
+    t.grains = t.solute + deterministic_sum(p.size(), Real(0), [&](Index i) { return p.solid_mass[i]; });
+    return t;
 }
-Real total_solute(const FluidParticles& f) {
-    return deterministic_sum(f.size(), Real(0), [&](Index i) { return f.solute[i]; });
+
+Index live_fragments(const State& s) {
+    Index n = 0;
+    for (const Fragment& f : s.porous.fragments) n += f.mass > 0;
+    return n;
 }
 
 /// Step length that reaches `target` in a whole number of steps no longer than dt_cfl, so
@@ -34,6 +53,28 @@ Real step_towards(Real dt_cfl, Real now, Real target) {
     const Real remaining = target - now;
     const Real n = std::max(Real(1), std::ceil(remaining / dt_cfl - 1e-9));
     return remaining / n;
+}
+
+/// Coupled scenes run the rigid fragments only (the Biot step is not coupled yet), so Biot
+/// boundary conditions would be silently ignored: refuse them.
+void check_coupled_scene(const Scene& scene) {
+    for (const PorousSolid& s : scene.porous_solids)
+        if (!s.constraints.empty())
+            throw SceneError(s.path + "/constraints",
+                             "no Biot constraints in a scene with fluid or free solids (the PFEM step runs only in "
+                             "poroelastic-only scenes so far)",
+                             fmt::format("{} constraints", s.constraints.size()));
+}
+
+/// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current
+/// positions (dissolution may have removed particles since the step's search).
+PointSet porous_frame(const Model& model, const State& state) {
+    const PorousParticles& p = state.porous.particles;
+    CellRanges cells;
+    NeighbourLists pairs;
+    sort_into_cells(model.porous_grid, p.x, cells);
+    find_neighbours(model.porous_grid, p.x, cells, true, pairs);
+    return porous_points(p, model.pore_laws, pairs, model.h);
 }
 
 }  // namespace
@@ -52,50 +93,63 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
-    if (!model.porous.empty()) {
-        if (!model.initial_x.empty())
-            throw SceneError("/porous_solids", "no fluid blocks beside porous solids (fluid-porous coupling is issue 3, not built yet)",
-                             fmt::format("{} fluid blocks", scene.fluid_blocks.size()));
-        return run_poroelastic(model, opt);
-    }
+    if (!model.porous.empty() && !model.coupled()) return run_poroelastic(model, opt);
+    check_coupled_scene(scene);
     State state = make_initial_state(model);
+    const bool porous = state.porous.size() > 0;
 
     RunResult result;
     result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
     FrameWriter out(result.out_dir, scene.output);
     out.write_boundary(model.walls);
+    auto write_frame = [&](const FrameLog& log) {
+        PointSet porous_points;
+        if (porous) porous_points = porous_frame(model, state);
+        out.write_frame({&state.fluid, nullptr, porous ? &porous_points : nullptr}, log);
+    };
 
     // Densities of the initial state, so frame 0 shows them.
     update_fluid_neighbours(model, state);
+    if (porous) {
+        update_porous_neighbours(model, state);
+        update_porous_boundary_volumes(model, state);
+    }
     update_density(model, state);
-    out.write_frame({&state.fluid}, {0, 0, 0, state.fluid.size(), 0, 0});
+    write_frame({0, 0, 0, state.fluid.size(), 0, 0});
 
-    const Real water_initial = total_mass(state.fluid), solute_initial = total_solute(state.fluid);
+    const MassTotals initial = mass_totals(state);
     StepProfile profile;
     ProgressLine progress(opt.quiet);
     Real max_density_error = 0, frame_density_error = 0;
     double particle_steps = 0, frame_particle_steps = 0, frame_step_seconds = 0;
     Stopwatch stepping;
     FluidParticles last_good;
+    PorousState last_good_porous;
     const Real end = scene.time.end;
     const Real frame_dt = 1 / scene.output.fps;
     int next_frame = 1;
 
     auto stats = [&] {
         const double step_seconds = profile.total();
+        const MassTotals final_totals = mass_totals(state);
         nlohmann::json phases;
         for (size_t s = 0; s < size_t(Stage::Count); ++s) phases[std::string(k_stage_names[s])] = profile.seconds[s];
         return nlohmann::json{
             {"scene", scene.name},
-            {"counts", {{"fluid", state.fluid.size()}, {"boundary", model.walls.size()}, {"porous", 0},
-                        {"elements", 0}, {"fragments", 0}, {"removed", state.removed}}},
+            {"counts", {{"fluid", state.fluid.size()}, {"boundary", model.walls.size()}, {"porous", state.porous.size()},
+                        {"elements", 0}, {"fragments", live_fragments(state)}, {"removed", state.removed},
+                        {"porous_removed", state.porous.removed}, {"dissolved", state.porous.dissolved},
+                        {"fluid_drained", state.porous.fluid_deleted}}},
             {"steps", state.steps},
             {"frames", out.frames()},
             {"sim_time", state.time},
             {"wall_time", wall.seconds()},
             {"phases", phases},
-            {"mass", {{"water_initial", water_initial}, {"water_final", total_mass(state.fluid)},
-                      {"solute_initial", solute_initial}, {"solute_final", total_solute(state.fluid)}}},
+            {"mass", {{"water_initial", initial.water}, {"water_final", final_totals.water},
+                      {"absorbed", state.porous.absorbed},
+                      {"absorbed_initial", initial.absorbed}, {"absorbed_final", final_totals.absorbed},
+                      {"solute_initial", initial.solute}, {"solute_final", final_totals.solute},
+                      {"grains_initial", initial.grains}, {"grains_final", final_totals.grains}}},
             {"max_density_error", max_density_error},
             {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
             {"threads", ThreadLimit::active_threads()},
@@ -109,6 +163,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             Real dt = cfl_time_step(model, state);
             if (!scene.time.fixed_dt) dt = step_towards(dt, state.time, frame_time);
             last_good = state.fluid;
+            if (porous) last_good_porous = state.porous;
             const Real last_good_time = state.time;
             StepReport report;
             try {
@@ -118,19 +173,21 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             } catch (const WatchdogError&) {
                 // Keep what was good: the state before the failing step becomes the last frame.
                 state.fluid = last_good;
+                if (porous) state.porous = last_good_porous;
                 state.time = last_good_time;
-                out.write_frame({&state.fluid}, {state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
+                write_frame({state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
                 throw;
             }
             max_density_error = std::max(max_density_error, report.max_density_error);
             frame_density_error = std::max(frame_density_error, report.max_density_error);
-            particle_steps += double(state.fluid.size());
-            frame_particle_steps += double(state.fluid.size());
+            const double particles = double(state.fluid.size() + state.porous.size());
+            particle_steps += particles;
+            frame_particle_steps += particles;
 
             const bool frame_due = state.time >= frame_time - 1e-9 * dt;
             if (frame_due) {
-                out.write_frame({&state.fluid}, {state.time, dt, state.steps, state.fluid.size(), frame_density_error,
-                                              frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
+                write_frame({state.time, dt, state.steps, state.fluid.size(), frame_density_error,
+                             frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
                 ++next_frame;
                 frame_density_error = 0, frame_particle_steps = 0, frame_step_seconds = 0;
             }
@@ -138,7 +195,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             const double rate = state.time / std::max(elapsed, 1e-9);
             progress.update({out.frames() - 1, state.time, end, state.steps / std::max(elapsed, 1e-9),
                              particle_steps / std::max(elapsed, 1e-9) / 1e6, (end - state.time) / std::max(rate, 1e-12),
-                             state.fluid.size()});
+                             state.fluid.size(), porous ? state.porous.absorbed : -1.0});
         }
     } catch (const WatchdogError& e) {
         progress.finish();

@@ -4,13 +4,21 @@
 #include "karst/core/timer.hpp"
 #include "karst/io/frame_writer.hpp"
 #include "karst/pfem/poroelastic_solid.hpp"
+#include "karst/scene/scene_error.hpp"
 #include "karst/sim/progress.hpp"
+
+#include <fmt/format.h>
 
 #include <cmath>
 
 namespace karst {
 
 RunResult run_poroelastic(const Model& model, const RunOptions& options) {
+    for (const PorousSolid& solid : model.scene.porous_solids)
+        if (solid.material.porosity < k_min_porosity)
+            throw SceneError(solid.path + "/material/porosity",
+                             "a porosity of at least 1e-4 in a poroelastic-only scene (an impermeable solid has no pore pressure)",
+                             fmt::format("{}", solid.material.porosity));
     const Scene& scene = model.scene;
     Stopwatch wall;
     RunResult result;
@@ -35,7 +43,7 @@ RunResult run_poroelastic(const Model& model, const RunOptions& options) {
         PointSet particles;
         for (size_t s = 0; s < solids.size(); ++s) {
             solids[s].append_to(frame);
-            solids[s].append_particles_to(particles, Index(s));
+            solids[s].append_particles_to(particles);
         }
         out.write_frame({nullptr, &frame, &particles}, {time, dt, steps, nodes, 0, 0});
     };

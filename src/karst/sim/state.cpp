@@ -15,6 +15,47 @@ void FluidParticles::permute(const std::vector<std::uint32_t>& perm) {
     apply_permutation(rho, perm), apply_permutation(p, perm), apply_permutation(id, perm);
 }
 
+namespace {
+
+/// Porous particles of every solid (method.md §2) and one fragment per solid (§4.5), at rest or
+/// with a free solid's initial velocity and spin.
+void make_porous(const Model& model, PorousState& porous) {
+    if (!model.coupled()) return;
+    PorousParticles& p = porous.particles;
+    const Real V0 = model.dx * model.dx * model.dx;
+    for (const PorousBody& body : model.porous) {
+        const PorousSolid& solid = model.scene.porous_solids[body.solid];
+        const PorousMaterial& mat = solid.material;
+        const Index first = p.size(), fragment = Index(porous.fragments.size());
+        for (size_t i = 0; i < body.rest_x.size(); ++i) {
+            const Vec3& x = body.rest_x[i];
+            Real S = mat.initial_saturation;
+            for (const WetRegion& w : solid.wet_regions)
+                if (w.region.signed_distance(x) <= 0) S = w.saturation;
+            p.x.push_back(x), p.v.push_back(Vec3::Zero()), p.volume.push_back(V0), p.porosity.push_back(mat.porosity);
+            p.absorbed_mass.push_back(mat.porosity >= k_min_porosity ? S * model.rho0 * mat.porosity * V0 : 0);
+            p.solid_mass.push_back(mat.solid_density * (1 - mat.porosity) * V0);
+            p.permeability.push_back(body.body_permeability[i]), p.body_permeability.push_back(body.body_permeability[i]);
+            p.fragment.push_back(fragment), p.material.push_back(body.solid), p.rest.push_back(Vec3::Zero());
+        }
+        const Index n = p.size() - first;
+        std::vector<Real> mass(n);
+        for (Index i = 0; i < n; ++i) mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];
+        std::vector<Vec3> rest;
+        Fragment f = fragment_at_rest({p.x.data() + first, size_t(n)}, mass, rest, model.dx);
+        std::copy(rest.begin(), rest.end(), p.rest.begin() + first);
+        f.anchored = solid.anchored;
+        if (!f.anchored) {
+            f.velocity = solid.velocity;
+            f.angular_momentum = f.world_inertia() * solid.angular_velocity;
+            for (Index i = first; i < p.size(); ++i) p.v[i] = f.point_velocity(p.x[i]);
+        }
+        porous.fragments.push_back(f);
+    }
+}
+
+}  // namespace
+
 State make_initial_state(const Model& model) {
     State s;
     const size_t n = model.initial_x.size();
@@ -28,6 +69,7 @@ State make_initial_state(const Model& model) {
     s.fluid.id.resize(n);
     for (size_t i = 0; i < n; ++i) s.fluid.id[i] = std::int64_t(i);
     s.next_id = std::int64_t(n);
+    make_porous(model, s.porous);
     return s;
 }
 

@@ -2,6 +2,8 @@
 // The mutable state (style.md P3/P4): fluid particles as one array per attribute, the time, and
 // per-step derived data (neighbour lists, accelerations) kept apart from the physical state.
 #include "karst/core/types.hpp"
+#include "karst/porous/pore_water.hpp"
+#include "karst/rigid/fragment.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 
 #include <vector>
@@ -40,11 +42,41 @@ struct FluidScratch {
     std::vector<Real> pair_coefficient;  ///< per fluid pair (list layout): m_j / rho0^2 dW/dr / r
     std::vector<Real> wall_coefficient;  ///< per wall pair: Psi_k / rho0^2 dW/dr / r
     std::vector<Real> wall_hydrostatic;  ///< per wall pair: -rho0 g.x_ik, Pa
+    NeighbourLists fluid_porous;         ///< porous neighbours within h (Akinci boundary, §4.1)
+    std::vector<Real> porous_coefficient;  ///< per porous pair: Psi_k / rho0^2 dW/dr / r
+    std::vector<Real> porous_hydrostatic;  ///< per porous pair: -rho0 g.x_ik, Pa
+};
+
+/// Porous particles and their fragments (method.md §2, §4.5): the physical state.
+struct PorousState {
+    PorousParticles particles;
+    std::vector<Fragment> fragments;  ///< indexed by PorousParticles::fragment; empty ones have mass 0
+    Real absorbed = 0;                ///< net water taken from fluid particles so far, kg
+    Index dissolved = 0;              ///< porous particles turned into muddy fluid (§4.8)
+    Index fluid_deleted = 0;          ///< drained fluid particles deleted (§4.7.3)
+    Index removed = 0;                ///< porous particles that left the domain
+    Index size() const { return particles.size(); }
+};
+
+/// Porous data rebuilt every step.
+struct PorousScratch {
+    CellRanges cells;                 ///< porous particles in the SPH grid (cell h)
+    CellRanges reach_cells;           ///< porous particles in the pore-flow grid (cell = kernel reach)
+    CellRanges fluid_reach_cells;     ///< fluid particles in the pore-flow grid
+    NeighbourLists porous_porous;     ///< within the kernel reach (M13), self excluded
+    NeighbourLists porous_fluid;      ///< fluid within the kernel reach
+    NeighbourLists porous_wall;       ///< wall particles within h
+    std::vector<Real> psi;            ///< Psi_k = gamma rho0 V_b,k of this step (§4.1), kg
+    std::vector<Vec3> force;          ///< fluid reactions and contact forces of this step, N
+    std::vector<Index> main_receiver; ///< per fluid particle: porous particle that took most of its water
+    Index contacts = 0;               ///< touching pairs of this step
 };
 
 struct State {
     FluidParticles fluid;
     FluidScratch scratch;
+    PorousState porous;
+    PorousScratch porous_scratch;
     Real time = 0;                ///< s
     Index steps = 0;
     Real dt = 0;                  ///< last step, s
@@ -53,7 +85,8 @@ struct State {
     std::int64_t next_id = 0;
 };
 
-/// Fluid at t = 0 from the model's sampled blocks.
+/// Fluid at t = 0 from the model's sampled blocks; porous particles and their fragments at rest
+/// (or with a free solid's initial velocity).
 State make_initial_state(const Model& model);
 
 }  // namespace karst

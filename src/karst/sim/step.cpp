@@ -3,6 +3,13 @@
 #include "karst/sim/step.hpp"
 
 #include "karst/core/timer.hpp"
+#include "karst/coupling/fluid_reactions.hpp"
+#include "karst/coupling/porous_boundary_volumes.hpp"
+#include "karst/coupling/porous_neighbours.hpp"
+#include "karst/porous/dissolution.hpp"
+#include "karst/porous/drained_fluid.hpp"
+#include "karst/porous/pore_flow.hpp"
+#include "karst/rigid/fragment_motion.hpp"
 #include "karst/sim/watchdog.hpp"
 #include "karst/sph/density.hpp"
 #include "karst/sph/fluid_neighbours.hpp"
@@ -26,35 +33,84 @@ auto timed(StepProfile& profile, Stage stage, const F& f) {
         return r;
     }
 }
+
+/// §3 step 8 at the step's start positions (where the neighbour lists were built): the pore
+/// flow among porous particles and with fluid particles, then the deletion of drained fluid.
+void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
+    PorousState& porous = state.porous;
+    FluidExchange fluid;
+    fluid.x = &state.fluid.x, fluid.mass = &state.fluid.mass, fluid.solute = &state.fluid.solute;
+    fluid.pressure = &state.fluid.p, fluid.porous_fluid = &state.porous_scratch.porous_fluid;
+    fluid.full_mass = model.particle_mass;
+    PoreFlow flow(model.pore_laws, model.h, model.dx);
+    const PoreFlowReport report = flow.advance(porous.particles, state.porous_scratch.porous_porous, dt, &fluid);
+    porous.absorbed += report.absorbed;
+    porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, fluid.main_receiver,
+                                                  state.scratch.fluid_fluid, model.particle_mass);
+}
+
+/// §3 step 9: saturated, porous-enough particles become muddy fluid; their fragments lose them.
+void dissolve_particles(const Model& model, State& state) {
+    DissolutionSettings settings{model.dissolution, model.particle_mass, model.dx};
+    const DissolutionReport r = dissolve(state.porous.particles, state.fluid, model.pore_laws, settings, state.next_id);
+    state.porous.dissolved += r.dissolved;
+}
+
 }  // namespace
 
 StepReport step(const Model& model, State& state, Real dt, StepProfile& profile) {
     const Real t = state.time;
     const auto& id = state.fluid.id;
+    const bool porous = state.porous.size() > 0;
 
-    // 1. Neighbour search (and periodic Morton reordering).
-    timed(profile, Stage::Neighbours, [&] { update_fluid_neighbours(model, state); });
+    // 1. Neighbour search (and periodic Morton reordering of the fluid), porous pairs after.
+    timed(profile, Stage::Neighbours, [&] {
+        update_fluid_neighbours(model, state);
+        if (porous) update_porous_neighbours(model, state);
+    });
 
-    // 2. Fluid densities with the wall contribution (M7).
-    timed(profile, Stage::Density, [&] { update_density(model, state); });
+    // 2. Akinci volumes of the porous particles (§4.1), fluid densities with the boundary (M7).
+    timed(profile, Stage::Density, [&] {
+        if (porous) update_porous_boundary_volumes(model, state);
+        update_density(model, state);
+    });
     check_scalars(state.fluid.rho, id, Stage::Density, t, "density");
 
     // 2b. Solute diffusion among fluid particles (M18), on this step's densities and lists.
     timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });
     check_scalars(state.fluid.solute, id, Stage::SoluteDiffusion, t, "solute mass");
 
-    // 3. Gravity, viscosity, surface tension, adhesion, wall friction (§4.2).
+    // 3. Gravity, viscosity, surface tension, adhesion, boundary friction (§4.2).
     timed(profile, Stage::NonPressureForces, [&] { compute_non_pressure_forces(model, state); });
     check_vectors(state.scratch.a_other, id, Stage::NonPressureForces, t, "acceleration");
 
-    // 4. PCISPH predict-correct loop (§4.3, M8).
+    // 4. PCISPH predict-correct loop with walls and porous particles as boundary (§4.3, M8).
     const PcisphReport pcisph = timed(profile, Stage::PressureSolve, [&] { return solve_pressure_pcisph(model, state, dt); });
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
 
-    // 5. Symplectic Euler; particles leaving the domain are removed (§4.4).
+    if (porous) {
+        // 4b. The fluid's last pressure, friction and adhesion act back on the porous particles.
+        timed(profile, Stage::FluidReactions, [&] { compute_fluid_reactions(model, state); });
+        // 5. Pore flow, absorption and drained fluid (§4.7), before anything moves.
+        timed(profile, Stage::PoreFlow, [&] { pore_flow_and_absorption(model, state, dt); });
+        check_scalars(state.porous.particles.absorbed_mass, {}, Stage::PoreFlow, t, "absorbed mass");
+    }
+
+    // 6. Symplectic Euler; particles leaving the domain, or drained, are removed (§4.4).
     state.a_max = timed(profile, Stage::Integrate, [&] { return integrate_fluid(model, state, dt); });
     check_vectors(state.fluid.v, state.fluid.id, Stage::Integrate, t + dt, "velocity", model.scene.max_speed);
     check_vectors(state.fluid.x, state.fluid.id, Stage::Integrate, t + dt, "position");
+
+    if (porous) {
+        // 7. Fragments: contacts, rigid integration, members follow (§4.5).
+        timed(profile, Stage::Fragments, [&] { advance_fragments(model, state, dt); });
+        // 8. Dissolution into muddy fluid (§4.8); the fragments' mass properties follow the
+        //    pore water and the members they lost.
+        timed(profile, Stage::Dissolution, [&] {
+            dissolve_particles(model, state);
+            refresh_fragment_mass(state, model.dx);
+        });
+    }
 
     state.time = t + dt;
     state.dt = dt;

@@ -37,7 +37,7 @@ void check_vectors(const std::vector<Vec3>& values, const std::vector<std::int64
     const std::string what = std::isfinite(norm)
                                  ? fmt::format("{} of magnitude {:.4g} exceeds the limit {:.4g}", quantity, norm, max_norm)
                                  : fmt::format("non-finite {}", quantity);
-    throw WatchdogError(k_stage_names[size_t(stage)], id[i], time, what);
+    throw WatchdogError(k_stage_names[size_t(stage)], id.empty() ? i : id[i], time, what);
 }
 
 void check_scalars(const std::vector<Real>& values, const std::vector<std::int64_t>& id, Stage stage,
@@ -45,7 +45,7 @@ void check_scalars(const std::vector<Real>& values, const std::vector<std::int64
     const Index n = Index(values.size());
     const Index i = first_bad(n, [&](Index k) { return !std::isfinite(values[k]); });
     if (i == n) return;
-    throw WatchdogError(k_stage_names[size_t(stage)], id[i], time, fmt::format("non-finite {}", quantity));
+    throw WatchdogError(k_stage_names[size_t(stage)], id.empty() ? i : id[i], time, fmt::format("non-finite {}", quantity));
 }
 
 }  // namespace karst

@@ -18,7 +18,8 @@ struct WatchdogError : std::runtime_error {
 };
 
 /// Throws WatchdogError if any entry of `values` is not finite (or, when max_norm > 0, longer
-/// than max_norm), naming `quantity`, the stage and the particle's id.
+/// than max_norm), naming `quantity`, the stage and the particle's id (its index when `id` is
+/// empty, as for porous particles).
 void check_vectors(const std::vector<Vec3>& values, const std::vector<std::int64_t>& id, Stage stage,
                    Real time, const char* quantity, Real max_norm = 0);
 void check_scalars(const std::vector<Real>& values, const std::vector<std::int64_t>& id, Stage stage,

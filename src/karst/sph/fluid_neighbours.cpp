@@ -9,6 +9,9 @@ void update_fluid_neighbours(const Model& model, State& state) {
     sort_into_cells(model.grid, state.fluid.x, s.cells);
     find_neighbours(model.grid, state.fluid.x, s.cells, true, s.fluid_fluid);
     find_neighbours(model.grid, state.fluid.x, model.walls.cells, false, s.fluid_wall);
+    // No porous neighbours until coupling/porous_neighbours.cpp lists them (scenes without porous
+    // solids never do).
+    s.fluid_porous.count.assign(state.fluid.size(), 0);
 }
 
 }  // namespace karst

@@ -11,17 +11,21 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
     FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
     const Index n = f.size();
-    std::vector<char> inside(n);
+    std::vector<char> keep(n);
+    std::vector<Index> escaped(n, 0);
     parallel_for(n, [&](Index i) {
         f.v[i] += dt * (s.a_other[i] + s.a_pressure[i]);
         f.x[i] += dt * f.v[i];
-        inside[i] = model.domain.contains(f.x[i]);
+        // Particles drained into the porous solid (mass 0, porous/drained_fluid.hpp) go too.
+        const bool inside = model.domain.contains(f.x[i]);
+        escaped[i] = !inside && f.mass[i] > 0;
+        keep[i] = inside && f.mass[i] > 0;
     });
     const Real a_max = parallel_max(n, 0.0, [&](Index i) { return (s.a_other[i] + s.a_pressure[i]).norm(); });
-    const Index kept = std::count(inside.begin(), inside.end(), 1);
+    const Index kept = std::count(keep.begin(), keep.end(), 1);
     if (kept != n) {
-        state.removed += n - kept;
-        f.keep(inside);
+        for (Index e : escaped) state.removed += e;
+        f.keep(keep);
     }
     return a_max;
 }
@@ -30,7 +34,9 @@ Real cfl_time_step(const Model& model, const State& state) {
     const TimeSettings& t = model.scene.time;
     if (t.fixed_dt) return *t.fixed_dt;
     const FluidParticles& f = state.fluid;
-    const Real v_max = std::sqrt(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }));
+    const PorousParticles& p = state.porous.particles;
+    const Real v_max = std::sqrt(std::max(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }),
+                                          parallel_max(p.size(), 0.0, [&](Index i) { return p.v[i].squaredNorm(); })));
     Real dt = t.dt_max;
     if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
     if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));

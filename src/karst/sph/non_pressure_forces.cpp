@@ -1,6 +1,7 @@
 #include "karst/sph/non_pressure_forces.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/coupling/boundary_pair.hpp"
 
 namespace karst {
 
@@ -22,7 +23,10 @@ void compute_normals(const Model& model, State& state) {
 
 void compute_non_pressure_forces(const Model& model, State& state) {
     const FluidSettings& fs = model.scene.fluid;
-    const bool tension = fs.surface_tension > 0, adhesion = fs.adhesion > 0, friction = fs.wall_friction > 0;
+    const bool tension = fs.surface_tension > 0;
+    const BoundaryShear shear{fs.wall_friction, fs.adhesion, fs.sound_speed, model.h};
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Real>& psi = state.porous_scratch.psi;
     if (tension) compute_normals(model, state);
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
@@ -50,18 +54,14 @@ void compute_non_pressure_forces(const Model& model, State& state) {
                 a += k_ij * fc;
             }
         });
-        if (adhesion || friction) {
-            // Akinci 2012 friction: nu_b = sigma_f h c_s / (2 rho_i).
-            const Real nu_b = fs.wall_friction * h * fs.sound_speed / (2 * rho_i);
+        if (shear.any()) {
+            // Friction and adhesion with walls (at rest) and porous particles (moving with their
+            // fragment); the porous reactions are summed in coupling/fluid_reactions.cpp.
             s.fluid_wall.for_each(i, [&](Index k) {
-                const Vec3 xik = xi - model.walls.x[k];
-                const Real r2 = xik.squaredNorm(), r = std::sqrt(r2);
-                const Real psi = model.walls.psi[k];
-                if (friction) {
-                    const Real pi_ik = -nu_b * std::min(vi.dot(xik), Real(0)) / (r2 + eps);
-                    a -= (psi * pi_ik * W.dw_over_r(r)) * xik;
-                }
-                if (adhesion && r > 1e-9 * h) a -= (fs.adhesion * psi * adhesion_kernel(r, h) / r) * xik;
+                a += boundary_shear_acceleration(shear, W, xi - model.walls.x[k], vi, rho_i, model.walls.psi[k]);
+            });
+            s.fluid_porous.for_each(i, [&](Index k) {
+                a += boundary_shear_acceleration(shear, W, xi - porous.x[k], vi - porous.v[k], rho_i, psi[k]);
             });
         }
         s.a_other[i] = a;

@@ -1,6 +1,7 @@
 #include "karst/sph/pcisph.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/coupling/boundary_pair.hpp"
 #include "karst/sph/density.hpp"
 
 namespace karst {
@@ -8,7 +9,7 @@ namespace karst {
 namespace {
 
 /// a_i^p = -sum_j m_j (p_i + p_j) / rho0^2 grad W_ij - sum_k Psi_k (p_i + p_ik) / rho0^2 grad W_ik
-/// at the current positions, then the prediction x*_i = x_i + dt (v_i + dt (a_other + a_p)) for
+/// (k: walls and porous particles) at the current positions, then the prediction x*_i = x_i + dt (v_i + dt (a_other + a_p)) for
 /// the next density pass.
 ///
 /// Wall pressure [D]: method.md §4.3 writes the wall term with p_i alone; the variant it names,
@@ -24,7 +25,8 @@ namespace {
 void pressure_acceleration_and_prediction(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity;
+    const std::vector<Vec3>& porous_x = state.porous.particles.x;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i];
         const Real pi = f.p[i];
@@ -37,8 +39,17 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
             const Real* hw = s.wall_hydrostatic.data() + i * cap_w;
             k = 0;
             s.fluid_wall.for_each(i, [&](Index w) {
-                const Real pik = std::max(pi + hw[k], Real(0));
-                a -= ((pi + pik) * cw[k++]) * (xi - model.walls.x[w]);
+                a -= boundary_pressure_term(pi, cw[k], hw[k], xi - model.walls.x[w]);
+                ++k;
+            });
+            // Porous particles are boundary particles like walls (§4.3); their reaction is
+            // the same term, summed on the fragment side (coupling/fluid_reactions.cpp).
+            const Real* cp = s.porous_coefficient.data() + i * cap_p;
+            const Real* hp = s.porous_hydrostatic.data() + i * cap_p;
+            k = 0;
+            s.fluid_porous.for_each(i, [&](Index w) {
+                a -= boundary_pressure_term(pi, cp[k], hp[k], xi - porous_x[w]);
+                ++k;
             });
         }
         s.a_pressure[i] = a;
@@ -55,10 +66,14 @@ void pair_coefficients(const Model& model, State& state) {
     const CubicKernel& W = model.kernel;
     const Real inv_rho0_2 = 1 / (model.rho0 * model.rho0);
     const Vec3 rho0_g = model.rho0 * model.scene.gravity;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity;
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Real>& psi = state.porous_scratch.psi;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
     s.pair_coefficient.resize(size_t(f.size()) * cap_f);
     s.wall_coefficient.resize(size_t(f.size()) * cap_w);
     s.wall_hydrostatic.resize(size_t(f.size()) * cap_w);
+    s.porous_coefficient.resize(size_t(f.size()) * cap_p);
+    s.porous_hydrostatic.resize(size_t(f.size()) * cap_p);
     parallel_for(f.size(), [&](Index i) {
         int k = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
@@ -67,8 +82,14 @@ void pair_coefficients(const Model& model, State& state) {
         k = 0;
         s.fluid_wall.for_each(i, [&](Index w) {
             const Vec3 xik = f.x[i] - model.walls.x[w];
-            s.wall_coefficient[i * cap_w + k] = model.walls.psi[w] * inv_rho0_2 * W.dw_over_r(xik.norm());
+            s.wall_coefficient[i * cap_w + k] = boundary_pressure_coefficient(model.walls.psi[w], inv_rho0_2, W, xik);
             s.wall_hydrostatic[i * cap_w + k++] = -rho0_g.dot(xik);
+        });
+        k = 0;
+        s.fluid_porous.for_each(i, [&](Index w) {
+            const Vec3 xik = f.x[i] - porous.x[w];
+            s.porous_coefficient[i * cap_p + k] = boundary_pressure_coefficient(psi[w], inv_rho0_2, W, xik);
+            s.porous_hydrostatic[i * cap_p + k++] = -rho0_g.dot(xik);
         });
     });
 }
@@ -81,6 +102,8 @@ void pair_coefficients(const Model& model, State& state) {
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
 /// diverges. Capping keeps the prototype everywhere it is stable (the interior, free surface).
 void compute_delta(const Model& model, const State& state, Real dt, std::vector<Real>& delta) {
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Real>& psi = state.porous_scratch.psi;
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
     const CubicKernel& W = model.kernel;
@@ -96,6 +119,7 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
             sum_sq += g.squaredNorm();
         });
         s.fluid_wall.for_each(i, [&](Index k) { sum_grad += model.walls.psi[k] * W.gradient(f.x[i] - model.walls.x[k]); });
+        s.fluid_porous.for_each(i, [&](Index k) { sum_grad += psi[k] * W.gradient(f.x[i] - porous.x[k]); });
         const Real denominator = sum_grad.squaredNorm() + sum_sq;
         delta[i] = denominator > 0 ? std::min(prototype, scale / denominator) : prototype;
     });
@@ -110,6 +134,8 @@ PcisphReport solve_pressure_pcisph(const Model& model, State& state, Real dt) {
     const FluidSettings& fs = model.scene.fluid;
     const Real rho0 = model.rho0;
     const CubicKernel& W = model.kernel;
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Real>& psi = state.porous_scratch.psi;
 
     // p starts at 0 every step (method.md §4.3). A warm start from the last step's pressure
     // (signed update, p >= 0) was tried: it smooths the pressure but left a resting column
@@ -130,6 +156,7 @@ PcisphReport solve_pressure_pcisph(const Model& model, State& state, Real dt) {
             Real rho = f.mass[i] * W.w0();
             s.fluid_fluid.for_each(i, [&](Index j) { rho += f.mass[j] * W.w((xi - s.x_pred[j]).norm()); });
             s.fluid_wall.for_each(i, [&](Index k) { rho += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm()); });
+            s.fluid_porous.for_each(i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
             const Real err = std::max(rho - rho0, Real(0));
             s.rho_err[i] = err;
             f.p[i] += s.delta[i] * err;

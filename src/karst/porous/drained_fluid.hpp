@@ -1,0 +1,18 @@
+#pragma once
+// Deletion of drained fluid particles (method.md §4.7.3): a fluid particle whose water has
+// almost all soaked into the porous solid gives the rest to the porous particle that took most
+// of it, and its solute to its nearest fluid neighbour.
+#include "karst/porous/pore_water.hpp"
+#include "karst/sim/state.hpp"
+
+namespace karst {
+
+/// For each fluid particle with water m - m_sol below `threshold` m_f0 and a main receiver
+/// (PoreFlow's FluidExchange::main_receiver): its water goes to that porous particle, its solute
+/// (as mass and solute) to the nearest fluid neighbour in `fluid_fluid`, and its mass becomes 0
+/// so the integration stage drops it. A particle with solute and no fluid neighbour is kept.
+/// Returns the number of particles drained this way. Totals of water and solute are unchanged.
+Index drain_fluid_particles(FluidParticles& fluid, PorousParticles& porous, const std::vector<Index>& main_receiver,
+                            const NeighbourLists& fluid_fluid, Real full_mass, Real threshold = 0.1);
+
+}  // namespace karst

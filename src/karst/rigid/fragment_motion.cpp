@@ -1,0 +1,121 @@
+#include "karst/rigid/fragment_motion.hpp"
+
+#include "karst/core/parallel.hpp"
+#include "karst/rigid/contact.hpp"
+
+#include <cmath>
+
+namespace karst {
+
+namespace {
+
+/// The contact law of method.md §4.2 for the lightest free fragment (mass M, N members).
+/// [D] The sheet's k_c = M g / (0.01 dx) holds a fragment on one particle. A fragment resting on
+/// a face touches about N^(2/3) particles, which is N^(2/3) times stiffer: omega^2 = N^(2/3) g /
+/// (0.01 dx), so omega dt = 9 for a 1000-particle cube at a 5 ms step, and explicit steps blow
+/// up. Dividing k_c by N^(2/3) keeps a face's sink at 0.01 dx and omega dt near 1; the damping
+/// gives e = 0.2 for that face against a wall (reduced mass M / N^(2/3)).
+ContactLaw fragment_contact_law(const Model& model, const State& state) {
+    std::vector<Index> members(state.porous.fragments.size(), 0);
+    for (Index f : state.porous.particles.fragment) ++members[f];
+    Real lightest = 0;
+    for (size_t f = 0; f < members.size(); ++f) {
+        const Fragment& fr = state.porous.fragments[f];
+        if (fr.anchored || members[f] == 0) continue;
+        const Real per_face = fr.mass / std::pow(Real(members[f]), 2.0 / 3.0);
+        if (lightest == 0 || per_face < lightest) lightest = per_face;
+    }
+    if (lightest == 0) {  // only anchored fragments: they touch but do not move
+        ContactLaw none;
+        none.rest_distance = model.dx;
+        return none;
+    }
+    const Real g = std::max(model.scene.gravity.norm(), Real(9.81));  // weightless scenes still collide
+    return ContactLaw::for_fragments(model.dx, lightest, g, 2 * lightest);
+}
+
+}  // namespace
+
+void advance_fragments(const Model& model, State& state, Real dt) {
+    PorousParticles& p = state.porous.particles;
+    std::vector<Fragment>& fragments = state.porous.fragments;
+    PorousScratch& s = state.porous_scratch;
+    const ContactLaw law = fragment_contact_law(model, state);
+    s.contacts = 0;
+    if (law.stiffness > 0) {
+        s.contacts += add_contact_forces(p, s.porous_porous, law, s.force);
+        s.contacts += add_wall_contact_forces(p, s.porous_wall, model.walls.x, law, s.force);
+    }
+    // F_r = sum_k F_k + M g, tau_r = sum_k (x_k - c) x F_k (§4.5), summed in particle order.
+    const size_t nf = fragments.size();
+    std::vector<Vec3> force(nf, Vec3::Zero()), torque(nf, Vec3::Zero());
+    for (Index k = 0; k < p.size(); ++k) {
+        const Index f = p.fragment[k];
+        force[f] += s.force[k];
+        torque[f] += (p.x[k] - fragments[f].centre).cross(s.force[k]);
+    }
+    std::vector<Mat3> rotation(nf);
+    std::vector<Vec3> omega(nf);
+    for (size_t f = 0; f < nf; ++f) {
+        Fragment& fr = fragments[f];
+        if (fr.mass > 0 && !fr.anchored) integrate_fragment(fr, force[f] + fr.mass * model.scene.gravity, torque[f], dt);
+        rotation[f] = fr.rotation_matrix();
+        omega[f] = fr.mass > 0 ? fr.angular_velocity() : Vec3::Zero();
+    }
+    std::vector<char> inside(p.size(), 1);
+    parallel_for(p.size(), [&](Index k) {
+        const Index f = p.fragment[k];
+        const Fragment& fr = fragments[f];
+        if (fr.anchored) return;
+        const Mat3& R = rotation[f];
+        p.x[k] = fr.centre + R * p.rest[k];
+        p.v[k] = fr.velocity + omega[f].cross(p.x[k] - fr.centre);
+        p.permeability[k] = R * p.body_permeability[k] * R.transpose();
+        inside[k] = model.domain.contains(p.x[k]);
+    });
+    const Index kept = std::count(inside.begin(), inside.end(), 1);
+    if (kept != p.size()) {
+        state.porous.removed += p.size() - kept;
+        p.keep(inside);
+        refresh_fragment_mass(state, model.dx);
+    }
+}
+
+void refresh_fragment_mass(State& state, Real spacing) {
+    PorousParticles& p = state.porous.particles;
+    std::vector<Fragment>& fragments = state.porous.fragments;
+    const size_t nf = fragments.size();
+    std::vector<Real> mass(nf, 0);
+    std::vector<Vec3> moment(nf, Vec3::Zero());
+    for (Index k = 0; k < p.size(); ++k) {
+        const Real m = p.solid_mass[k] + p.absorbed_mass[k];
+        mass[p.fragment[k]] += m, moment[p.fragment[k]] += m * p.x[k];
+    }
+    std::vector<Mat3> inertia(nf, Mat3::Zero());
+    std::vector<Vec3> centre(nf);
+    std::vector<Mat3> rotation(nf);
+    for (size_t f = 0; f < nf; ++f) {
+        centre[f] = mass[f] > 0 ? Vec3(moment[f] / mass[f]) : fragments[f].centre;
+        rotation[f] = fragments[f].rotation_matrix();
+    }
+    for (Index k = 0; k < p.size(); ++k) {
+        const Index f = p.fragment[k];
+        const Vec3 X = rotation[f].transpose() * (p.x[k] - centre[f]);
+        p.rest[k] = X;
+        inertia[f] += member_inertia(p.solid_mass[k] + p.absorbed_mass[k], X, spacing);
+    }
+    for (size_t f = 0; f < nf; ++f) {
+        Fragment& fr = fragments[f];
+        const Vec3 omega = fr.mass > 0 ? fr.angular_velocity() : Vec3::Zero();
+        if (mass[f] > 0) fr.velocity += omega.cross(centre[f] - fr.centre);
+        fr.centre = centre[f], fr.mass = mass[f];
+        if (mass[f] == 0) {
+            fr.velocity.setZero(), fr.angular_momentum.setZero();
+            continue;
+        }
+        fr.body_inertia = inertia[f];
+        fr.angular_momentum = fr.world_inertia() * omega;
+    }
+}
+
+}  // namespace karst

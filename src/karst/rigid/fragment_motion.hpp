@@ -1,0 +1,21 @@
+#pragma once
+// The fragments' step (method.md §4.5, §3 steps 6-7): contact springs, the sum of the forces on
+// their members, rigid integration and the members' new positions, velocities and world
+// permeability tensors; and the mass properties after pore water or members change.
+#include "karst/sim/model.hpp"
+#include "karst/sim/state.hpp"
+
+namespace karst {
+
+/// Stage: adds contact forces to state.porous_scratch.force, integrates every free fragment
+/// under those forces and gravity, then moves its members: x = c + R X, v = v_c + omega x (x - c),
+/// K = R K0 R^T (M12). Porous particles leaving the domain are removed and counted.
+void advance_fragments(const Model& model, State& state, Real dt);
+
+/// Mass, centre and inertia of every fragment from its members (M = sum m_s + m_p, wet mass
+/// included). The rigid velocity field is kept: v moves to the new centre (v + omega x dc) and
+/// L = I_w omega, so members that leave (dissolution) take exactly their own momentum.
+/// `spacing` is dx (each member's own inertia, rigid/fragment.hpp).
+void refresh_fragment_mass(State& state, Real spacing);
+
+}  // namespace karst

@@ -1,0 +1,37 @@
+#include "karst/sim/porous_materials.hpp"
+
+#include "karst/porous/layering_frame.hpp"
+#include "karst/porous/permeability.hpp"
+
+#include <cmath>
+
+namespace karst {
+
+PoreWaterLaw pore_water_law(const PorousMaterial& mat, Real rest_density, const Vec3& gravity) {
+    PoreWaterLaw law;
+    law.rest_density = rest_density, law.capillary_scale = mat.capillary_pressure;
+    law.capillary_exponent = mat.capillary_exponent, law.pore_stiffness = mat.pore_stiffness;
+    law.saturation_exponent = mat.saturation_exponent, law.darcy_viscosity = mat.darcy_viscosity;
+    law.gravity = gravity;
+    law.absorption_factor = mat.absorption_factor;
+    return law;
+}
+
+std::vector<Mat3> body_permeabilities(const PorousMaterial& mat, const std::vector<Vec3>& rest_x, Real h) {
+    using L = PorousMaterial::Layering;
+    const Real k0 = mat.permeability, ratio = mat.layering_ratio;
+    if (mat.layering == L::Fibre) {
+        // k_par k_perp^2 = k0^3 with k_par = ratio k_perp.
+        const Real k_perp = k0 * std::pow(ratio, -1.0 / 3.0);
+        return std::vector<Mat3>(rest_x.size(), fibre_permeability(ratio * k_perp, k_perp, mat.layering_normal));
+    }
+    if (mat.layering == L::Bedding || ratio == 1)
+        return std::vector<Mat3>(rest_x.size(), layered_permeability(k0, mat.layering_normal, ratio));
+    const std::vector<PcaFrame> frames = pca_frames(rest_x, h);
+    std::vector<Mat3> K(rest_x.size());
+    for (size_t i = 0; i < rest_x.size(); ++i)
+        K[i] = layered_permeability(k0, frames[i].reliable() ? frames[i].normal() : mat.layering_normal, ratio);
+    return K;
+}
+
+}  // namespace karst
