@@ -115,5 +115,25 @@ TEST(Hydrostatic, PressureWithinTwoPercentOfLocalRho0GDepthBelowTopFourLayers) {
     }
 }
 
+// A wide, shallow tank at the default fluid settings stays at rest. Without damping (alpha_v = 0,
+// nu = 1e-6) the corner particles start a slosh that reached 6 m/s within 0.6 s.
+TEST(Hydrostatic, ShallowTankAtDefaultSettingsStaysAtRest) {
+    ThreadLimit one(1);
+    test::Simulation sim(R"({
+      "name": "tank", "particle_spacing": 0.02,
+      "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.2] } } ],
+      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.4] } } ]
+    })");
+    Real max_speed = 0;
+    sim.run_until(1.0, [&] {
+        for (const Vec3& v : sim.state.fluid.v) max_speed = std::max(max_speed, v.norm());
+    });
+    Real rms = 0;
+    for (const Vec3& v : sim.state.fluid.v) rms += v.squaredNorm();
+    rms = std::sqrt(rms / Real(sim.state.fluid.size()));
+    EXPECT_LT(max_speed, 0.4) << "m/s, largest speed over 1 s";
+    EXPECT_LT(rms, 0.08) << "m/s at 1 s";
+}
+
 }  // namespace
 }  // namespace karst

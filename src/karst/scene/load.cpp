@@ -70,6 +70,7 @@ Scene parse_scene(const std::string& text) {
 
     const json& f = doc["fluid"];
     s.fluid.rest_density = f["rest_density"], s.fluid.viscosity = f["viscosity"];
+    s.fluid.artificial_viscosity = f["artificial_viscosity"];
     s.fluid.surface_tension = f["surface_tension"], s.fluid.adhesion = f["adhesion"];
     s.fluid.wall_friction = f["wall_friction"], s.fluid.sound_speed = f["sound_speed"];
     s.fluid.solute_diffusivity = f["solute_diffusivity"];

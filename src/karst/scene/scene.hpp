@@ -22,6 +22,7 @@ struct TimeSettings {
 struct FluidSettings {
     Real rest_density = 1000;       ///< rho0, kg/m^3
     Real viscosity = 1e-6;          ///< nu, m^2/s
+    Real artificial_viscosity = 0.01;  ///< alpha_v (Becker & Teschner 2007)
     Real surface_tension = 0;       ///< gamma_st
     Real adhesion = 0;              ///< beta_adh
     Real wall_friction = 0;         ///< sigma_f

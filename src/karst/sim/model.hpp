@@ -34,6 +34,7 @@ struct Model {
     Real h = 0;                 ///< support radius 2 dx, m
     Real rho0 = 1000;           ///< kg/m^3
     Real particle_mass = 0;     ///< m_f0 = rho0 dx^3, kg
+    Real lattice_volume = 0;    ///< dx^3 / (dx^3 sum_lattice W): a boundary lattice site's volume, m^3
     CubicKernel kernel{1.0};
     /// |sum grad W|^2 + sum |grad W|^2 on a full lattice neighbourhood (1/m^8): the prototype
     /// particle of M8, fixed by the lattice, so delta(dt) is closed-form.
@@ -49,7 +50,6 @@ struct Model {
     std::vector<PoreWaterLaw> pore_laws;
     std::vector<DissolutionThreshold> dissolution;
     UniformGrid porous_grid;      ///< cell = the longest porous kernel reach (M13), at least h
-    Real porous_gamma = 1;        ///< Akinci calibration of a thick boundary, for porous Psi (§4.1)
     /// Porous solids run coupled with the fluid as rigid fragments; else they are poroelastic-only.
     bool coupled() const { return !porous.empty() && (!initial_x.empty() || any_free_solid()); }
     bool any_free_solid() const {

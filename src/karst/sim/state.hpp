@@ -66,7 +66,7 @@ struct PorousScratch {
     NeighbourLists porous_porous;     ///< within the kernel reach (M13), self excluded
     NeighbourLists porous_fluid;      ///< fluid within the kernel reach
     NeighbourLists porous_wall;       ///< wall particles within h
-    std::vector<Real> psi;            ///< Psi_k = gamma rho0 V_b,k of this step (§4.1), kg
+    std::vector<Real> psi;            ///< Psi_k = rho0 V_k of this step (§4.1), kg
     std::vector<Vec3> force;          ///< fluid reactions and contact forces of this step, N
     std::vector<Index> main_receiver; ///< per fluid particle: porous particle that took most of its water
     Index contacts = 0;               ///< touching pairs of this step

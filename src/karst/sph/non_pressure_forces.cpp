@@ -33,6 +33,9 @@ void compute_non_pressure_forces(const Model& model, State& state) {
     const CubicKernel& W = model.kernel;
     const Real h = model.h, eps = 0.01 * h * h, rho0 = model.rho0;
     const Real visc = (3 + 2) * fs.viscosity;
+    // Becker & Teschner 2007: Pi_ij = -nu_a min(v_ij.x_ij, 0) / (r^2 + 0.01 h^2) with
+    // nu_a = 2 alpha_v h c_s / (rho_i + rho_j); a_i = -sum_j m_j Pi_ij grad W_ij.
+    const Real artificial = 2 * fs.artificial_viscosity * h * fs.sound_speed;
     s.a_other.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i], vi = f.v[i];
@@ -44,6 +47,7 @@ void compute_non_pressure_forces(const Model& model, State& state) {
             const Vec3 grad = xij * W.dw_over_r(std::sqrt(r2));
             const Real vx = (vi - f.v[j]).dot(xij);
             a += (visc * f.mass[j] * (1 / rho_i + 1 / f.rho[j]) * vx / (r2 + eps)) * grad;
+            if (vx < 0) a += (artificial / (rho_i + f.rho[j]) * f.mass[j] * vx / (r2 + eps)) * grad;
             if (tension) {
                 // Akinci 2013: K_ij (cohesion + curvature), per unit mass of i.
                 const Real r = std::sqrt(r2);
