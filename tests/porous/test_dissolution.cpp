@@ -22,7 +22,7 @@ TEST(Dissolution, ConvertsOnlySaturatedHighPorosityParticlesAndConservesMassSolu
         porous.permeability.push_back(Mat3::Identity() * 1e-10), porous.fragment.push_back(0);
     }
     FluidParticles fluid;  // one particle already there
-    fluid.x = {Vec3(0, 1, 0)}, fluid.v = {Vec3::Zero()}, fluid.mass = {mf0}, fluid.solute = {0}, fluid.rho = {rho0}, fluid.p = {0}, fluid.id = {0};
+    fluid.x = {Vec3(0, 1, 0)}, fluid.v = {Vec3::Zero()}, fluid.mass = {mf0}, fluid.sph_mass = {mf0}, fluid.solute = {0}, fluid.drained = {0}, fluid.rho = {rho0}, fluid.p = {0}, fluid.id = {0};
     auto totals = [&] {
         Real mass = 0, solute = 0;
         Vec3 momentum = Vec3::Zero();
@@ -37,7 +37,7 @@ TEST(Dissolution, ConvertsOnlySaturatedHighPorosityParticlesAndConservesMassSolu
     };
     const auto [mass0, solute0, momentum0] = totals();
     std::int64_t next_id = 1;
-    const DissolutionReport r = dissolve(porous, fluid, {&law, 1}, {{{0.98, 0.6}}, mf0, dx}, next_id);
+    const DissolutionReport r = dissolve(porous, fluid, {&law, 1}, {{{0.98, 0.6, 2650}}, mf0, dx}, next_id);
     EXPECT_EQ(r.dissolved, 2);
     ASSERT_EQ(porous.size(), 2);
     EXPECT_EQ(porous.x[0], Vec3(dx, 0, 0));

@@ -24,7 +24,7 @@ void compute_fluid_reactions(const Model& model, State& state) {
             if (f.p[i] != 0)
                 a_on_i -= boundary_pressure_term(f.p[i], boundary_pressure_coefficient(s.psi[k], inv_rho0_2, W, x_ik), -rho0_g.dot(x_ik), x_ik);
             if (shear.any()) a_on_i += boundary_shear_acceleration(shear, W, x_ik, f.v[i] - porous.v[k], f.rho[i], s.psi[k]);
-            force -= f.mass[i] * a_on_i;
+            force -= f.sph_mass[i] * a_on_i;  // = m_i times the fluid side's acceleration
         });
         s.force[k] = force;
     });

@@ -15,10 +15,11 @@ Vec3 piece_offset(int piece, Real dx) {
 }  // namespace
 
 DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::span<const PoreWaterLaw> laws,
-                           const DissolutionSettings& settings, std::int64_t& next_id) {
+                           const DissolutionSettings& settings, std::int64_t& next_id, const std::vector<char>& exposed) {
     DissolutionReport report;
     std::vector<char> keep(porous.size(), 1);
     for (Index i = 0; i < porous.size(); ++i) {
+        if (!exposed.empty() && !exposed[i]) continue;
         const Real phi = porous.porosity[i];
         const PoreWaterLaw& law = laws[porous.material_of(i)];
         const DissolutionThreshold& threshold = settings.thresholds[porous.material_of(i)];
@@ -26,6 +27,7 @@ DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::
         if (law.saturation(porous.absorbed_mass[i], phi, porous.volume[i]) < threshold.saturation) continue;
         keep[i] = 0, ++report.dissolved;
         const Real m = porous.solid_mass[i] + porous.absorbed_mass[i], solute = porous.solid_mass[i];
+        const Real sph_mass = porous.absorbed_mass[i] + solute * law.rest_density / threshold.grain_density;  // rho0 V
         const int pieces = m > 2 * settings.fluid_particle_mass ? int(std::ceil(m / settings.fluid_particle_mass)) : 1;
         // Equal pieces, the last taking the rounding remainder, so the sums are exact.
         Real mass_left = m, solute_left = solute;
@@ -36,7 +38,9 @@ DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::
             fluid.x.push_back(porous.x[i] + (pieces > 1 ? piece_offset(k, settings.spacing) : Vec3::Zero()));
             fluid.v.push_back(porous.v[i]);
             fluid.mass.push_back(mk);
+            fluid.sph_mass.push_back(sph_mass * (mk / m));
             fluid.solute.push_back(sk);
+            fluid.drained.push_back(0);
             fluid.rho.push_back(law.rest_density);
             fluid.p.push_back(0);
             fluid.id.push_back(next_id++);

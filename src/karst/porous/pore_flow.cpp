@@ -14,16 +14,24 @@ PoreFlow::PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing)
     KARST_CHECK(!m_laws.empty());
 }
 
-void PoreFlow::refresh(const PorousParticles& p) {
+void PoreFlow::refresh_metric(const PorousParticles& p) {
     const Index n = p.size();
-    m_G.resize(n), m_det_g.resize(n), m_mobility.resize(n), m_saturation.resize(n), m_potential.resize(n);
+    m_G.resize(n), m_det_g.resize(n), m_mobility.resize(n);
+    parallel_for(n, [&](Index i) {
+        const KernelMetric metric = kernel_metric(p.permeability[i], m_h);
+        m_G[i] = metric.G, m_det_g[i] = metric.det_g, m_mobility[i] = metric.k_ref / law(p, i).darcy_viscosity;
+    });
+}
+
+void PoreFlow::refresh_state(const PorousParticles& p) {
+    const Index n = p.size();
+    m_saturation.resize(n), m_potential.resize(n), m_relative_permeability.resize(n);
     m_outflow_scale.assign(n, 1);
     parallel_for(n, [&](Index i) {
         const PoreWaterLaw& l = law(p, i);
-        const KernelMetric metric = kernel_metric(p.permeability[i], m_h);
-        m_G[i] = metric.G, m_det_g[i] = metric.det_g, m_mobility[i] = metric.k_ref / l.darcy_viscosity;
         m_saturation[i] = p.porosity[i] >= k_min_porosity ? l.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]) : 0;
         m_potential[i] = l.flow_potential(m_saturation[i], p.x[i]);
+        m_relative_permeability[i] = std::pow(std::min(m_saturation[i], Real(1)), l.saturation_exponent);
     });
 }
 
@@ -39,19 +47,6 @@ Real PoreFlow::pair_conductance(const PorousParticles& p, Index lo, Index hi) co
     return law(p, lo).rest_density * p.volume[lo] * p.volume[hi] * mobility / (m_h * m_h) * F;
 }
 
-Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j) const {
-    const Index lo = std::min(i, j), hi = std::max(i, j);
-    const Real dphi = m_potential[hi] - m_potential[lo];
-    if (dphi == 0) return 0;
-    const Real conductance = pair_conductance(p, lo, hi);
-    if (conductance == 0) return 0;
-    // Relative permeability of the donor (larger Phi), upwinded.
-    const Index donor = dphi > 0 ? hi : lo;
-    const Real kr = std::pow(std::min(m_saturation[donor], Real(1)), law(p, donor).saturation_exponent);
-    const Real into_lo = conductance * kr * dphi * m_outflow_scale[donor];
-    return i == lo ? into_lo : -into_lo;
-}
-
 Real PoreFlow::fluid_conductance(const PorousParticles& p, Index k, const Vec3& x, Real m) const {
     if (p.porosity[k] < k_min_porosity) return 0;
     // M15/M16 for a fluid-porous pair: rho0 V_k (m / rho0) chi k_porous F(x, G_porous) / (eta h^2).
@@ -59,34 +54,79 @@ Real PoreFlow::fluid_conductance(const PorousParticles& p, Index k, const Vec3& 
     return p.volume[k] * m * law(p, k).absorption_factor * m_mobility[k] / (m_h * m_h) * F;
 }
 
+void PoreFlow::cache_conductances(const PorousParticles& p, const NeighbourLists& neighbours, const FluidExchange* fluid) {
+    const Index n = p.size();
+    const int cap = neighbours.capacity, cap_f = fluid ? fluid->porous_fluid->capacity : 0;
+    m_conductance.resize(size_t(n) * cap);
+    m_fluid_conductance.resize(size_t(n) * cap_f);
+    m_conductance_sum.resize(n);
+    parallel_for(n, [&](Index i) {
+        Real sum = 0;
+        int s = 0;
+        neighbours.for_each(i, [&](Index j) {
+            // (min, max) order: both sides of a pair hold bitwise the same value.
+            const Real c = pair_conductance(p, std::min(i, j), std::max(i, j));
+            m_conductance[i * cap + s++] = c;
+            sum += c;
+        });
+        if (fluid) {
+            s = 0;
+            fluid->porous_fluid->for_each(i, [&](Index f) {
+                const Real c = fluid_conductance(p, i, (*fluid->x)[f] - p.x[i], (*fluid->sph_mass)[f]);
+                m_fluid_conductance[i * cap_f + s++] = c;
+                sum += c;
+            });
+        }
+        m_conductance_sum[i] = sum;
+    });
+}
+
+Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j, Real conductance) const {
+    const Index lo = std::min(i, j), hi = std::max(i, j);
+    const Real dphi = m_potential[hi] - m_potential[lo];
+    if (dphi == 0 || conductance == 0) return 0;
+    // Relative permeability of the donor (larger Phi), upwinded.
+    const Index donor = dphi > 0 ? hi : lo;
+    const Real into_lo = conductance * m_relative_permeability[donor] * dphi * m_outflow_scale[donor];
+    return i == lo ? into_lo : -into_lo;
+}
+
 void PoreFlow::fluid_pair_fluxes(const PorousParticles& p, const FluidExchange& fluid) {
     const NeighbourLists& lists = *fluid.porous_fluid;
     const int cap = lists.capacity;
     m_fluid_flux.resize(size_t(p.size()) * cap);
     parallel_for(p.size(), [&](Index k) {
+        const Real* c = m_fluid_conductance.data() + k * cap;
         Real* flux = m_fluid_flux.data() + k * cap;
         int s = 0;
         lists.for_each(k, [&](Index f) {
             const Real dphi = m_fluid_potential[f] - m_potential[k];
             Real q = 0;
-            const Real c = dphi == 0 ? 0 : fluid_conductance(p, k, (*fluid.x)[f] - p.x[k], (*fluid.mass)[f]);
-            if (c > 0) {
-                if (dphi > 0) q = c * dphi * m_fluid_donor_scale[f];  // the fluid gives, k_r = 1 (S = 1)
+            if (c[s] > 0 && dphi != 0) {
+                if (dphi > 0) q = c[s] * dphi * m_fluid_donor_scale[f];  // the fluid gives, k_r = 1 (S = 1)
                 else  // the porous particle gives back, k_r of its own S, to a fluid receiver
-                    q = c * std::pow(std::min(m_saturation[k], Real(1)), law(p, k).saturation_exponent) * dphi *
-                        m_outflow_scale[k] * m_fluid_receiver_scale[f];
+                    q = c[s] * m_relative_permeability[k] * dphi * m_outflow_scale[k] * m_fluid_receiver_scale[f];
             }
             flux[s++] = q;
         });
     });
 }
 
+template <class F>
+void PoreFlow::for_each_pair(const PorousParticles& p, const NeighbourLists& neighbours, Index i, const F& f) const {
+    const Real* c = m_conductance.data() + i * neighbours.capacity;
+    int s = 0;
+    neighbours.for_each(i, [&](Index j) { f(pair_flux(p, i, j, c[s++])); });
+}
+
 void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours, std::vector<Real>& rate) {
-    refresh(p);
+    refresh_metric(p);
+    cache_conductances(p, neighbours, nullptr);
+    refresh_state(p);
     rate.assign(p.size(), 0);
     parallel_for(p.size(), [&](Index i) {
         Real sum = 0;
-        neighbours.for_each(i, [&](Index j) { sum += pair_flux(p, i, j); });
+        for_each_pair(p, neighbours, i, [&](Real q) { sum += q; });
         rate[i] = sum;
     });
 }
@@ -98,11 +138,14 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
     const int cap = fluid ? fluid->porous_fluid->capacity : 0;
     auto for_each_fluid_pair = [&](const auto& f) {  // serial, in (porous, slot) order: deterministic
         if (!fluid) return;
-        for (Index k = 0; k < n; ++k) {
-            int s = 0;
-            fluid->porous_fluid->for_each(k, [&](Index j) { f(k, j, k * cap + s++); });
-        }
+        for (Index k = 0; k < n; ++k)
+            for (int s = 0; s < fluid->porous_fluid->count[k]; ++s)
+                f(k, Index(fluid->porous_fluid->index[k * cap + s]), size_t(k * cap + s));
     };
+    // Positions, tensors and volumes hold for the whole step: the pair conductances are
+    // computed once, and each sub-step only re-reads S and Phi.
+    refresh_metric(p);
+    cache_conductances(p, neighbours, fluid);
     if (fluid) {
         // Phi_f = max(p, 0) - rho0 g.x (M6); the fluid pressure is this step's and stays fixed.
         m_fluid_potential.resize(nf);
@@ -115,21 +158,15 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
     std::vector<Real> rate(n), outflow(n), fluid_out(nf), fluid_in(nf);
     Real remaining = dt;
     while (remaining > 0) {
-        refresh(p);
+        refresh_state(p);
         m_fluid_donor_scale.assign(nf, 1), m_fluid_receiver_scale.assign(nf, 1);
         // Sub-step limit (§4.7.5): explicit diffusion is stable for dt sum_j c_ij dPhi_i/dm_i <= 1;
         // half of that, with k_r = 1 as its upper bound. A fluid particle's Phi does not depend on
         // its mass, so only porous particles limit the step.
         const Real stiffness = parallel_max(n, Real(0), [&](Index i) {
             if (p.porosity[i] < k_min_porosity) return Real(0);
-            Real sum = 0;
-            neighbours.for_each(i, [&](Index j) { sum += pair_conductance(p, std::min(i, j), std::max(i, j)); });
-            if (fluid)
-                fluid->porous_fluid->for_each(i, [&](Index f) {
-                    sum += fluid_conductance(p, i, (*fluid->x)[f] - p.x[i], (*fluid->mass)[f]);
-                });
             const PoreWaterLaw& l = law(p, i);
-            return sum * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
+            return m_conductance_sum[i] * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
         });
         const Real limit = stiffness > 0 ? 0.5 / stiffness : remaining;
         const Real steps = std::ceil(remaining / limit - 1e-12);
@@ -141,7 +178,7 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
         if (fluid) fluid_pair_fluxes(p, *fluid);
         parallel_for(n, [&](Index i) {
             Real out = 0;
-            neighbours.for_each(i, [&](Index j) { out += std::max(-pair_flux(p, i, j), Real(0)); });
+            for_each_pair(p, neighbours, i, [&](Real q) { out += std::max(-q, Real(0)); });
             if (fluid)
                 for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) out += std::max(-m_fluid_flux[i * cap + s], Real(0));
             outflow[i] = out;
@@ -158,8 +195,9 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
             }
         if (fluid) {
             for (Index f = 0; f < nf; ++f) {
-                const Real mass = (*fluid->mass)[f], water = mass - (*fluid->solute)[f];
-                const Real room = std::max(fluid->full_mass - mass, Real(0));
+                const Real mass = (*fluid->mass)[f], drained = (*fluid->drained)[f];
+                const Real water = mass - (*fluid->solute)[f] - drained;
+                const Real room = std::max(fluid->full_mass - mass + drained, Real(0));
                 if (fluid_out[f] * h_sub > water) {
                     m_fluid_donor_scale[f] = std::max(water, Real(0)) / (fluid_out[f] * h_sub);
                     ++report.limited_donors;
@@ -170,15 +208,17 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
         }
         parallel_for(n, [&](Index i) {
             Real sum = 0;
-            neighbours.for_each(i, [&](Index j) { sum += pair_flux(p, i, j); });
+            for_each_pair(p, neighbours, i, [&](Real q) { sum += q; });
             if (fluid)
                 for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) sum += m_fluid_flux[i * cap + s];
             rate[i] = sum;
         });
         for (Index i = 0; i < n; ++i) p.absorbed_mass[i] = std::max(p.absorbed_mass[i] + h_sub * rate[i], Real(0));
         for_each_fluid_pair([&](Index, Index f, size_t slot) {
-            const Real dm = h_sub * m_fluid_flux[slot];
-            (*fluid->mass)[f] -= dm;
+            const Real dm = h_sub * m_fluid_flux[slot];  // into the porous particle
+            Real& drained = (*fluid->drained)[f];
+            drained += dm;
+            if (drained < 0) (*fluid->mass)[f] -= drained, (*fluid->sph_mass)[f] -= drained, drained = 0;  // back-flow beyond what it gave
             m_fluid_transfer[slot] += dm;
             report.absorbed += dm;
         });

@@ -17,11 +17,15 @@ struct PoreFlowReport {
 };
 
 /// The fluid particles taking part in the pore flow (§4.7.3): each is a pore-water donor or
-/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6), volume m / rho0.
+/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6), volume m / rho0. A donor's water
+/// goes into `drained` (the SPH mass stays until the particle is deleted); water received
+/// first refills `drained`, then adds to the mass up to m_f0.
 struct FluidExchange {
     const std::vector<Vec3>* x = nullptr;          ///< fluid positions, m
-    std::vector<Real>* mass = nullptr;             ///< fluid masses, kg (changed)
-    const std::vector<Real>* solute = nullptr;     ///< solute masses, kg: water is m - m_sol
+    std::vector<Real>* mass = nullptr;             ///< fluid SPH masses m, kg (changed by back-flow)
+    std::vector<Real>* drained = nullptr;          ///< water already given, kg (changed)
+    std::vector<Real>* sph_mass = nullptr;         ///< rho0 V, kg (grows with the mass on back-flow)
+    const std::vector<Real>* solute = nullptr;     ///< solute masses, kg: water is m - m_sol - drained
     const std::vector<Real>* pressure = nullptr;   ///< PCISPH pressure of this step, Pa
     const NeighbourLists* porous_fluid = nullptr;  ///< per porous particle: fluid within kernel reach
     Real full_mass = 0;                            ///< m_f0: no transfer fills a fluid particle beyond it, kg
@@ -45,16 +49,23 @@ public:
 
 private:
     const PoreWaterLaw& law(const PorousParticles& p, Index i) const { return m_laws[p.material_of(i)]; }
-    /// Per particle: G (M13), det G, mobility k_ref / eta, S and Phi.
-    void refresh(const PorousParticles& particles);
+    /// Per particle: G (M13), det G and the mobility k_ref / eta.
+    void refresh_metric(const PorousParticles& particles);
+    /// Per particle: S (M3), Phi (M6) and k_r; limiter scales back to 1.
+    void refresh_state(const PorousParticles& particles);
     /// rho0 V_lo V_hi (k/eta)_pair F c_eps / h^2 of M15/M16 (lo < hi), kg/(s Pa) without k_r;
     /// 0 for impermeable particles and for fragments not in contact.
     Real pair_conductance(const PorousParticles& particles, Index lo, Index hi) const;
+    /// Conductance of porous k with a fluid particle of volume m / rho0 at offset x (M15, fluid pair).
+    Real fluid_conductance(const PorousParticles& particles, Index k, const Vec3& x, Real m) const;
+    /// Every pair's conductance in the slots of the neighbour lists, and their sum per particle.
+    void cache_conductances(const PorousParticles& particles, const NeighbourLists& neighbours, const FluidExchange* fluid);
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
-    Real pair_flux(const PorousParticles& particles, Index i, Index j) const;
-    /// Conductance of porous k with a fluid particle of mass m at offset x (M15, fluid pair).
-    Real fluid_conductance(const PorousParticles& particles, Index k, const Vec3& x, Real m) const;
+    Real pair_flux(const PorousParticles& particles, Index i, Index j, Real conductance) const;
+    /// Calls f(q_{j->i}) for every listed neighbour j of i.
+    template <class F>
+    void for_each_pair(const PorousParticles& particles, const NeighbourLists& neighbours, Index i, const F& f) const;
     /// Flux into each porous particle from each listed fluid particle (kg/s), in the slots of
     /// fluid.porous_fluid, with the current limiter scales.
     void fluid_pair_fluxes(const PorousParticles& particles, const FluidExchange& fluid);
@@ -63,9 +74,12 @@ private:
     Real m_h, m_spacing, m_calibration;
     std::vector<Mat3> m_G;
     std::vector<Real> m_det_g, m_mobility, m_saturation, m_potential, m_outflow_scale;
+    std::vector<Real> m_relative_permeability;  ///< k_r = min(S, 1)^beta per particle
     std::vector<Real> m_fluid_potential;                 ///< per fluid particle, Pa
     std::vector<Real> m_fluid_donor_scale, m_fluid_receiver_scale;  ///< per fluid particle, limiter
     std::vector<Real> m_fluid_flux, m_fluid_transfer;    ///< per porous-fluid slot: kg/s, kg this step
+    std::vector<Real> m_conductance, m_fluid_conductance;  ///< per list slot, kg/(s Pa)
+    std::vector<Real> m_conductance_sum;                 ///< per porous particle, kg/(s Pa)
 };
 
 }  // namespace karst

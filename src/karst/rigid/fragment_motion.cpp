@@ -1,6 +1,7 @@
 #include "karst/rigid/fragment_motion.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/core/soa.hpp"
 #include "karst/rigid/contact.hpp"
 
 #include <cmath>
@@ -46,6 +47,7 @@ void advance_fragments(const Model& model, State& state, Real dt) {
         s.contacts += add_contact_forces(p, s.porous_porous, law, s.force);
         s.contacts += add_wall_contact_forces(p, s.porous_wall, model.walls.x, law, s.force);
     }
+
     // F_r = sum_k F_k + M g, tau_r = sum_k (x_k - c) x F_k (§4.5), summed in particle order.
     const size_t nf = fragments.size();
     std::vector<Vec3> force(nf, Vec3::Zero()), torque(nf, Vec3::Zero());
@@ -77,6 +79,7 @@ void advance_fragments(const Model& model, State& state, Real dt) {
     if (kept != p.size()) {
         state.porous.removed += p.size() - kept;
         p.keep(inside);
+        keep_flagged(s.exposed, inside);
         refresh_fragment_mass(state, model.dx);
     }
 }

@@ -202,7 +202,7 @@ void set_up_porous_materials(Model& m) {
     }
     for (const PorousSolid& solid : m.scene.porous_solids) {
         m.pore_laws.push_back(pore_water_law(solid.material, m.rho0, m.scene.gravity));
-        m.dissolution.push_back({solid.material.dissolution_saturation, solid.material.dissolution_porosity});
+        m.dissolution.push_back({solid.material.dissolution_saturation, solid.material.dissolution_porosity, solid.material.solid_density});
     }
     m.porous_grid = UniformGrid(m.domain, reach);
 }

@@ -24,8 +24,8 @@ namespace karst {
 
 namespace {
 
-/// The conserved totals (method.md §4.7-4.8): water is the fluid's mass less its solute plus
-/// the pore water; grains are the solute plus the porous particles' solid mass.
+/// The conserved totals (method.md §4.7-4.8): water is the fluid's mass less its solute and
+/// the water it already gave (drained), plus the pore water; grains are the solute plus the porous particles' solid mass.
 struct MassTotals {
     Real water = 0, solute = 0, absorbed = 0, grains = 0;
 };
@@ -36,7 +36,7 @@ MassTotals mass_totals(const State& s) {
     MassTotals t;
     t.solute = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.solute[i]; });
     t.absorbed = deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
-    t.water = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.mass[i] - f.solute[i]; }) + t.absorbed;
+    t.water = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.mass[i] - f.solute[i] - f.drained[i]; }) + t.absorbed;
     t.grains = t.solute + deterministic_sum(p.size(), Real(0), [&](Index i) { return p.solid_mass[i]; });
     return t;
 }

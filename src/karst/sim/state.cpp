@@ -6,12 +6,14 @@
 namespace karst {
 
 void FluidParticles::keep(const std::vector<char>& flag) {
-    keep_flagged(x, flag), keep_flagged(v, flag), keep_flagged(mass, flag), keep_flagged(solute, flag);
+    keep_flagged(x, flag), keep_flagged(v, flag), keep_flagged(mass, flag), keep_flagged(solute, flag), keep_flagged(drained, flag);
+    keep_flagged(sph_mass, flag);
     keep_flagged(rho, flag), keep_flagged(p, flag), keep_flagged(id, flag);
 }
 
 void FluidParticles::permute(const std::vector<std::uint32_t>& perm) {
     apply_permutation(x, perm), apply_permutation(v, perm), apply_permutation(mass, perm), apply_permutation(solute, perm);
+    apply_permutation(drained, perm), apply_permutation(sph_mass, perm);
     apply_permutation(rho, perm), apply_permutation(p, perm), apply_permutation(id, perm);
 }
 
@@ -63,6 +65,8 @@ State make_initial_state(const Model& model) {
     s.fluid.v = model.initial_v;
     s.fluid.mass.assign(n, model.particle_mass);
     s.fluid.solute.resize(n);
+    s.fluid.drained.assign(n, 0);
+    s.fluid.sph_mass = s.fluid.mass;
     for (size_t i = 0; i < n; ++i) s.fluid.solute[i] = model.initial_concentration[i] * model.particle_mass;
     s.fluid.rho.assign(n, model.rho0);
     s.fluid.p.assign(n, 0);

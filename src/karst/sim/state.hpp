@@ -17,7 +17,14 @@ struct FluidParticles {
     std::vector<Vec3> x;          ///< (n) position, m
     std::vector<Vec3> v;          ///< (n) velocity, m/s
     std::vector<Real> mass;       ///< (n) kg
+    /// (n) rho0 V: the mass of water filling the particle's volume, kg. SPH sums weigh
+    /// neighbours by it, and forces per unit of it act on the true mass. It equals m for water;
+    /// muddy particles are smaller, V = m_water / rho0 + m_grains / rho_s (porous/dissolution.hpp).
+    std::vector<Real> sph_mass;
     std::vector<Real> solute;     ///< (n) solute mass m_sol, kg; concentration C = m_sol / m
+    /// (n) water already soaked into porous solids that the particle still carries as SPH mass,
+    /// kg: its water is m - m_sol - drained (porous/drained_fluid.hpp says why).
+    std::vector<Real> drained;
     std::vector<Real> rho;        ///< (n) density of the last step (M7), kg/m^3
     std::vector<Real> p;          ///< (n) PCISPH pressure of the last step, Pa
     std::vector<std::int64_t> id; ///< (n) stable particle id (export only)
@@ -68,7 +75,7 @@ struct PorousScratch {
     NeighbourLists porous_wall;       ///< wall particles within h
     std::vector<Real> psi;            ///< Psi_k = rho0 V_k of this step (§4.1), kg
     std::vector<Vec3> force;          ///< fluid reactions and contact forces of this step, N
-    std::vector<Index> main_receiver; ///< per fluid particle: porous particle that took most of its water
+    std::vector<char> exposed;        ///< per porous particle: a fluid particle lies within h (may dissolve)
     Index contacts = 0;               ///< touching pairs of this step
 };
 

@@ -2,6 +2,7 @@
 // into the profile and followed by the watchdog's check of what it wrote.
 #include "karst/sim/step.hpp"
 
+#include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/coupling/fluid_reactions.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
@@ -39,7 +40,9 @@ auto timed(StepProfile& profile, Stage stage, const F& f) {
 void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     PorousState& porous = state.porous;
     FluidExchange fluid;
-    fluid.x = &state.fluid.x, fluid.mass = &state.fluid.mass, fluid.solute = &state.fluid.solute;
+    fluid.x = &state.fluid.x, fluid.mass = &state.fluid.mass, fluid.drained = &state.fluid.drained;
+    fluid.sph_mass = &state.fluid.sph_mass;
+    fluid.solute = &state.fluid.solute;
     fluid.pressure = &state.fluid.p, fluid.porous_fluid = &state.porous_scratch.porous_fluid;
     fluid.full_mass = model.particle_mass;
     PoreFlow flow(model.pore_laws, model.h, model.dx);
@@ -47,12 +50,28 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     porous.absorbed += report.absorbed;
     porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, fluid.main_receiver,
                                                   state.scratch.fluid_fluid, model.particle_mass);
+    // Which porous particles may dissolve (porous/dissolution.hpp), while the lists hold: fluid
+    // lies within h, and none closer than 0.6 dx.
+    PorousScratch& s = state.porous_scratch;
+    const std::vector<Vec3>& x = porous.particles.x;
+    const Real touch = model.h * model.h, crowd = 0.36 * model.dx * model.dx;
+    s.exposed.assign(x.size(), 0);
+    parallel_for(Index(x.size()), [&](Index k) {
+        bool wet = false, crowded = false;
+        s.porous_fluid.for_each(k, [&](Index i) {
+            if (state.fluid.mass[i] == 0) return;
+            const Real r2 = (state.fluid.x[i] - x[k]).squaredNorm();
+            wet = wet || r2 < touch, crowded = crowded || r2 < crowd;
+        });
+        s.exposed[k] = wet && !crowded;
+    });
 }
 
 /// §3 step 9: saturated, porous-enough particles become muddy fluid; their fragments lose them.
 void dissolve_particles(const Model& model, State& state) {
     DissolutionSettings settings{model.dissolution, model.particle_mass, model.dx};
-    const DissolutionReport r = dissolve(state.porous.particles, state.fluid, model.pore_laws, settings, state.next_id);
+    const DissolutionReport r =
+        dissolve(state.porous.particles, state.fluid, model.pore_laws, settings, state.next_id, state.porous_scratch.exposed);
     state.porous.dissolved += r.dissolved;
 }
 

@@ -14,7 +14,7 @@ void compute_normals(const Model& model, State& state) {
     s.normal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         Vec3 n = Vec3::Zero();
-        s.fluid_fluid.for_each(i, [&](Index j) { n += (f.mass[j] / f.rho[j]) * model.kernel.gradient(f.x[i] - f.x[j]); });
+        s.fluid_fluid.for_each(i, [&](Index j) { n += (f.sph_mass[j] / f.rho[j]) * model.kernel.gradient(f.x[i] - f.x[j]); });
         s.normal[i] = model.h * n;
     });
 }
@@ -40,20 +40,20 @@ void compute_non_pressure_forces(const Model& model, State& state) {
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i], vi = f.v[i];
         const Real rho_i = f.rho[i];
-        Vec3 a = model.scene.gravity;
+        Vec3 a = Vec3::Zero();
         s.fluid_fluid.for_each(i, [&](Index j) {
             const Vec3 xij = xi - f.x[j];
             const Real r2 = xij.squaredNorm();
             const Vec3 grad = xij * W.dw_over_r(std::sqrt(r2));
             const Real vx = (vi - f.v[j]).dot(xij);
-            a += (visc * f.mass[j] * (1 / rho_i + 1 / f.rho[j]) * vx / (r2 + eps)) * grad;
-            if (vx < 0) a += (artificial / (rho_i + f.rho[j]) * f.mass[j] * vx / (r2 + eps)) * grad;
+            a += (visc * f.sph_mass[j] * (1 / rho_i + 1 / f.rho[j]) * vx / (r2 + eps)) * grad;
+            if (vx < 0) a += (artificial / (rho_i + f.rho[j]) * f.sph_mass[j] * vx / (r2 + eps)) * grad;
             if (tension) {
                 // Akinci 2013: K_ij (cohesion + curvature), per unit mass of i.
                 const Real r = std::sqrt(r2);
                 const Real k_ij = 2 * rho0 / (rho_i + f.rho[j]);
                 Vec3 fc = Vec3::Zero();
-                if (r > 1e-9 * h) fc = (-fs.surface_tension * f.mass[j] * cohesion_kernel(r, h) / r) * xij;
+                if (r > 1e-9 * h) fc = (-fs.surface_tension * f.sph_mass[j] * cohesion_kernel(r, h) / r) * xij;
                 fc -= fs.surface_tension * (s.normal[i] - s.normal[j]);
                 a += k_ij * fc;
             }
@@ -68,7 +68,8 @@ void compute_non_pressure_forces(const Model& model, State& state) {
                 a += boundary_shear_acceleration(shear, W, xi - porous.x[k], vi - porous.v[k], rho_i, psi[k]);
             });
         }
-        s.a_other[i] = a;
+        // Forces per unit rho0 V act on the true mass; gravity on every kilogram.
+        s.a_other[i] = model.scene.gravity + (f.sph_mass[i] / f.mass[i]) * a;
     });
 }
 

@@ -52,6 +52,7 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
                 ++k;
             });
         }
+        a *= f.sph_mass[i] / f.mass[i];  // a force per unit rho0 V acting on the true mass
         s.a_pressure[i] = a;
         s.x_pred[i] = xi + dt * (f.v[i] + dt * (s.a_other[i] + a));
     });
@@ -77,7 +78,7 @@ void pair_coefficients(const Model& model, State& state) {
     parallel_for(f.size(), [&](Index i) {
         int k = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
-            s.pair_coefficient[i * cap_f + k++] = f.mass[j] * inv_rho0_2 * W.dw_over_r((f.x[i] - f.x[j]).norm());
+            s.pair_coefficient[i * cap_f + k++] = f.sph_mass[j] * inv_rho0_2 * W.dw_over_r((f.x[i] - f.x[j]).norm());
         });
         k = 0;
         s.fluid_wall.for_each(i, [&](Index w) {
@@ -114,7 +115,7 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
         Vec3 sum_grad = Vec3::Zero();
         Real sum_sq = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
-            const Vec3 g = f.mass[j] * W.gradient(f.x[i] - f.x[j]);
+            const Vec3 g = f.sph_mass[j] * W.gradient(f.x[i] - f.x[j]);
             sum_grad += g;
             sum_sq += g.squaredNorm();
         });
@@ -153,8 +154,8 @@ PcisphReport solve_pressure_pcisph(const Model& model, State& state, Real dt) {
         // Predicted density at x* (walls stay put), clamped error, pressure update.
         parallel_for(n, [&](Index i) {
             const Vec3 xi = s.x_pred[i];
-            Real rho = f.mass[i] * W.w0();
-            s.fluid_fluid.for_each(i, [&](Index j) { rho += f.mass[j] * W.w((xi - s.x_pred[j]).norm()); });
+            Real rho = f.sph_mass[i] * W.w0();
+            s.fluid_fluid.for_each(i, [&](Index j) { rho += f.sph_mass[j] * W.w((xi - s.x_pred[j]).norm()); });
             s.fluid_wall.for_each(i, [&](Index k) { rho += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm()); });
             s.fluid_porous.for_each(i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
             const Real err = std::max(rho - rho0, Real(0));
