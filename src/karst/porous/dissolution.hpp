@@ -32,8 +32,10 @@ struct DissolutionReport {
 /// volumes of fluid into one lattice site, 16 % over-dense, and blew it out at 250 m/s) and the particle's velocity, split into ceil(m / m_f0) pieces when
 /// m > 2 m_f0; the porous particle is removed (its fragment must then update its mass
 /// properties and remesh, method.md §4.8). New fluid ids continue from `next_id`.
-/// [D] Only particles in `exposed` (touching fluid; all when empty) dissolve: the grains leave
-/// the rock at its surface. A saturated interior particle turned into fluid sits in a one-site
+/// [D] Only particles in `exposed` (all when empty) dissolve: those with fluid within h and none
+/// closer than 0.6 dx (sim/step.cpp), so the grains leave the rock at its surface into open
+/// water. A fluid particle pressed closer than that would overlap the new one (0.2 dx was seen)
+/// and the pressure needed to part them blew the block apart. A saturated interior particle turned into fluid sits in a one-site
 /// cavity among boundary particles, about 16 % over-dense, and its pressure blew a soaking
 /// block apart (151 m/s within 0.6 s); from the surface inward, the rock erodes layer by layer.
 DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::span<const PoreWaterLaw> laws,

@@ -21,7 +21,7 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
         escaped[i] = !inside && f.mass[i] > 0;
         keep[i] = inside && f.mass[i] > 0;
     });
-    const Real a_max = parallel_max(n, 0.0, [&](Index i) { return (s.a_other[i] + s.a_pressure[i]).norm(); });
+    const Real a_max = parallel_max(n, 0.0, [&](Index i) { return s.a_other[i].norm(); });
     const Index kept = std::count(keep.begin(), keep.end(), 1);
     if (kept != n) {
         for (Index e : escaped) state.removed += e;
