@@ -8,9 +8,8 @@ void update_porous_neighbours(const Model& model, State& state) {
     sort_into_cells(model.grid, x, s.cells);
     find_neighbours(model.grid, state.fluid.x, s.cells, false, state.scratch.fluid_porous);
     find_neighbours(model.grid, x, model.walls.cells, false, s.porous_wall);
-    sort_into_cells(model.porous_grid, x, s.reach_cells);
+    find_neighbours(model.grid, x, s.cells, true, s.porous_porous);
     sort_into_cells(model.porous_grid, state.fluid.x, s.fluid_reach_cells);
-    find_neighbours(model.porous_grid, x, s.reach_cells, true, s.porous_porous);
     find_neighbours(model.porous_grid, x, s.fluid_reach_cells, false, s.porous_fluid);
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Neighbour search for porous particles (method.md §3 step 1): fluid-porous pairs within h for
-// the Akinci boundary, and porous-porous, porous-fluid pairs within the longest kernel reach
-// (M13) for the pore flow, porous-wall pairs within h for the Akinci volumes and contacts.
+// the Akinci boundary, porous-porous and porous-wall pairs within h for the Akinci volumes and
+// contacts, and porous-fluid pairs within the longest kernel reach (M13) for absorption.
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 

@@ -54,23 +54,61 @@ Real PoreFlow::fluid_conductance(const PorousParticles& p, Index k, const Vec3& 
     return p.volume[k] * m * law(p, k).absorption_factor * m_mobility[k] / (m_h * m_h) * F;
 }
 
-void PoreFlow::cache_conductances(const PorousParticles& p, const NeighbourLists& neighbours, const FluidExchange* fluid) {
+PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candidates, PairSelection selection) {
+    refresh_metric(p);
     const Index n = p.size();
-    const int cap = neighbours.capacity, cap_f = fluid ? fluid->porous_fluid->capacity : 0;
-    m_conductance.resize(size_t(n) * cap);
+    const int cap = candidates.capacity;
+    std::vector<Real> c(size_t(n) * cap, 0);
+    std::vector<Index> kept(n, 0);
+    parallel_for(n, [&](Index i) {
+        int s = 0;
+        candidates.for_each(i, [&](Index j) {
+            const bool same = p.fragment[i] == p.fragment[j];
+            const bool wanted = selection == PairSelection::All || (selection == PairSelection::SameFragment) == same;
+            // (min, max) order: both sides of a pair hold bitwise the same value.
+            const Real value = wanted ? pair_conductance(p, std::min(i, j), std::max(i, j)) : 0;
+            c[i * cap + s++] = value;
+            kept[i] += value > 0;
+        });
+    });
+    PorePairs out;
+    out.start.assign(n + 1, 0);
+    for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + kept[i];
+    out.other.resize(out.start[n]), out.conductance.resize(out.start[n]);
+    parallel_for(n, [&](Index i) {
+        Index at = out.start[i];
+        int s = 0;
+        candidates.for_each(i, [&](Index j) {
+            const Real value = c[i * cap + s++];
+            if (value > 0) out.other[at] = j, out.conductance[at++] = value;
+        });
+    });
+    return out;
+}
+
+PorePairs merge_pairs(const PorePairs& a, const PorePairs& b) {
+    PorePairs out;
+    const Index n = a.rows();
+    out.start.assign(n + 1, 0);
+    for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + (a.start[i + 1] - a.start[i]) + (b.start[i + 1] - b.start[i]);
+    out.other.reserve(out.start[n]), out.conductance.reserve(out.start[n]);
+    for (Index i = 0; i < n; ++i)
+        for (const PorePairs* set : {&a, &b})
+            for (Index s = set->start[i]; s < set->start[i + 1]; ++s)
+                out.other.push_back(set->other[s]), out.conductance.push_back(set->conductance[s]);
+    return out;
+}
+
+void PoreFlow::cache_conductances(const PorousParticles& p, const PorePairs& pairs, const FluidExchange* fluid) {
+    const Index n = p.size();
+    const int cap_f = fluid ? fluid->porous_fluid->capacity : 0;
     m_fluid_conductance.resize(size_t(n) * cap_f);
     m_conductance_sum.resize(n);
     parallel_for(n, [&](Index i) {
         Real sum = 0;
-        int s = 0;
-        neighbours.for_each(i, [&](Index j) {
-            // (min, max) order: both sides of a pair hold bitwise the same value.
-            const Real c = pair_conductance(p, std::min(i, j), std::max(i, j));
-            m_conductance[i * cap + s++] = c;
-            sum += c;
-        });
+        for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) sum += pairs.conductance[s];
         if (fluid) {
-            s = 0;
+            int s = 0;
             fluid->porous_fluid->for_each(i, [&](Index f) {
                 const Real c = fluid_conductance(p, i, (*fluid->x)[f] - p.x[i], (*fluid->sph_mass)[f]);
                 m_fluid_conductance[i * cap_f + s++] = c;
@@ -113,25 +151,30 @@ void PoreFlow::fluid_pair_fluxes(const PorousParticles& p, const FluidExchange& 
 }
 
 template <class F>
-void PoreFlow::for_each_pair(const PorousParticles& p, const NeighbourLists& neighbours, Index i, const F& f) const {
-    const Real* c = m_conductance.data() + i * neighbours.capacity;
-    int s = 0;
-    neighbours.for_each(i, [&](Index j) { f(pair_flux(p, i, j, c[s++])); });
+void PoreFlow::for_each_pair(const PorousParticles& p, const PorePairs& pairs, Index i, const F& f) const {
+    for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) {
+        const Index j = pairs.other[s];
+        if (m_wet.empty() || m_wet[i] || m_wet[j]) f(pair_flux(p, i, j, pairs.conductance[s]));
+    }
 }
 
 void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours, std::vector<Real>& rate) {
-    refresh_metric(p);
-    cache_conductances(p, neighbours, nullptr);
+    const PorePairs pair_set = pairs(p, neighbours);
     refresh_state(p);
+    m_wet.clear();
     rate.assign(p.size(), 0);
     parallel_for(p.size(), [&](Index i) {
         Real sum = 0;
-        for_each_pair(p, neighbours, i, [&](Real q) { sum += q; });
+        for_each_pair(p, pair_set, i, [&](Real q) { sum += q; });
         rate[i] = sum;
     });
 }
 
 PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neighbours, Real dt, FluidExchange* fluid) {
+    return advance(p, pairs(p, neighbours), dt, fluid);
+}
+
+PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours, Real dt, FluidExchange* fluid) {
     PoreFlowReport report;
     const Index n = p.size();
     const Index nf = fluid ? Index(fluid->mass->size()) : 0;
@@ -157,13 +200,32 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
     }
     std::vector<Real> rate(n), outflow(n), fluid_out(nf), fluid_in(nf);
     Real remaining = dt;
+    std::vector<char> active(n);
+    std::vector<Index> rows;
     while (remaining > 0) {
         refresh_state(p);
         m_fluid_donor_scale.assign(nf, 1), m_fluid_receiver_scale.assign(nf, 1);
+        // Pairs of which neither particle is wet (S > 1e-6) nor touches fluid carry nothing: the
+        // explicit scheme spreads traces a kernel reach per sub-step, which would otherwise wake
+        // the whole block. Both sides of a pair apply the same test, so water is still conserved
+        // exactly; only the rows of wet particles and their partners are visited.
+        m_wet.resize(n);
+        std::fill(active.begin(), active.end(), 0);
+        for (Index i = 0; i < n; ++i) m_wet[i] = m_saturation[i] > 1e-6 || (fluid && fluid->porous_fluid->count[i] > 0);
+        for (Index i = 0; i < n; ++i) {
+            if (!m_wet[i]) continue;
+            active[i] = 1;
+            for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s) active[neighbours.other[s]] = 1;
+        }
+        rows.clear();
+        for (Index i = 0; i < n; ++i)
+            if (active[i]) rows.push_back(i);
+        const Index nr = Index(rows.size());
         // Sub-step limit (§4.7.5): explicit diffusion is stable for dt sum_j c_ij dPhi_i/dm_i <= 1;
         // half of that, with k_r = 1 as its upper bound. A fluid particle's Phi does not depend on
         // its mass, so only porous particles limit the step.
-        const Real stiffness = parallel_max(n, Real(0), [&](Index i) {
+        const Real stiffness = parallel_max(nr, Real(0), [&](Index r) {
+            const Index i = rows[r];
             if (p.porosity[i] < k_min_porosity) return Real(0);
             const PoreWaterLaw& l = law(p, i);
             return m_conductance_sum[i] * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
@@ -175,23 +237,35 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
         // Donor limiter (Zalesak-style): a donor may not give more than it has this sub-step, and
         // a fluid receiver may not fill beyond m_f0; all of a limited particle's outgoing (or
         // incoming) pair fluxes are scaled alike, and each stays antisymmetric.
+        // One pass gives each particle's outflow and its unlimited net rate; the rates are
+        // summed again only when some donor or receiver was limited.
         if (fluid) fluid_pair_fluxes(p, *fluid);
-        parallel_for(n, [&](Index i) {
-            Real out = 0;
-            for_each_pair(p, neighbours, i, [&](Real q) { out += std::max(-q, Real(0)); });
-            if (fluid)
-                for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) out += std::max(-m_fluid_flux[i * cap + s], Real(0));
-            outflow[i] = out;
-        });
+        auto sum_rates = [&](bool with_outflow) {
+            parallel_for(nr, [&](Index r) {
+                const Index i = rows[r];
+                Real out = 0, sum = 0;
+                for_each_pair(p, neighbours, i, [&](Real q) { sum += q, out += std::max(-q, Real(0)); });
+                if (fluid)
+                    for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) {
+                        const Real q = m_fluid_flux[i * cap + s];
+                        sum += q, out += std::max(-q, Real(0));
+                    }
+                rate[i] = sum;
+                if (with_outflow) outflow[i] = out;
+            });
+        };
+        std::fill(rate.begin(), rate.end(), 0), std::fill(outflow.begin(), outflow.end(), 0);
+        sum_rates(true);
         std::fill(fluid_out.begin(), fluid_out.end(), 0), std::fill(fluid_in.begin(), fluid_in.end(), 0);
         for_each_fluid_pair([&](Index, Index f, size_t slot) {
             const Real q = m_fluid_flux[slot];
             (q > 0 ? fluid_out[f] : fluid_in[f]) += std::abs(q);
         });
+        bool limited = false, fluid_limited = false;
         for (Index i = 0; i < n; ++i)
             if (outflow[i] * h_sub > p.absorbed_mass[i]) {
                 m_outflow_scale[i] = p.absorbed_mass[i] / (outflow[i] * h_sub);
-                ++report.limited_donors;
+                ++report.limited_donors, limited = true;
             }
         if (fluid) {
             for (Index f = 0; f < nf; ++f) {
@@ -200,19 +274,13 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
                 const Real room = std::max(fluid->full_mass - mass + drained, Real(0));
                 if (fluid_out[f] * h_sub > water) {
                     m_fluid_donor_scale[f] = std::max(water, Real(0)) / (fluid_out[f] * h_sub);
-                    ++report.limited_donors;
+                    ++report.limited_donors, fluid_limited = true;
                 }
-                if (fluid_in[f] * h_sub > room) m_fluid_receiver_scale[f] = room / (fluid_in[f] * h_sub);
+                if (fluid_in[f] * h_sub > room) m_fluid_receiver_scale[f] = room / (fluid_in[f] * h_sub), fluid_limited = true;
             }
-            fluid_pair_fluxes(p, *fluid);  // again, with the scales
+            if (limited || fluid_limited) fluid_pair_fluxes(p, *fluid);  // again, with the scales
         }
-        parallel_for(n, [&](Index i) {
-            Real sum = 0;
-            for_each_pair(p, neighbours, i, [&](Real q) { sum += q; });
-            if (fluid)
-                for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) sum += m_fluid_flux[i * cap + s];
-            rate[i] = sum;
-        });
+        if (limited || fluid_limited) sum_rates(false);
         for (Index i = 0; i < n; ++i) p.absorbed_mass[i] = std::max(p.absorbed_mass[i] + h_sub * rate[i], Real(0));
         for_each_fluid_pair([&](Index, Index f, size_t slot) {
             const Real dm = h_sub * m_fluid_flux[slot];  // into the porous particle

@@ -34,6 +34,22 @@ struct FluidExchange {
     std::vector<Index> main_receiver;
 };
 
+/// Porous pairs that exchange pore water with their conductances rho0 V_i V_j (k/eta)_ij F_ij
+/// c_eps / h^2 (M15/M16 without k_r), kg/(s Pa), in compressed rows: the partners of i are
+/// other[start[i] .. start[i + 1]). Every pair is listed from both sides with the same value.
+struct PorePairs {
+    std::vector<Index> start{0};
+    std::vector<Index> other;
+    std::vector<Real> conductance;
+    Index rows() const { return Index(start.size()) - 1; }
+};
+
+/// Which candidate pairs a PorePairs keeps.
+enum class PairSelection { All, SameFragment, AcrossFragments };
+
+/// Joins two pair sets over the same particles, row by row.
+PorePairs merge_pairs(const PorePairs& a, const PorePairs& b);
+
 /// Transport over dt. `neighbours` lists, for every porous particle, the porous particles
 /// within the largest kernel reach (kernel_reach of M13); `h` is the isotropic support radius.
 class PoreFlow {
@@ -43,6 +59,13 @@ public:
     PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing);
     PoreFlowReport advance(PorousParticles& particles, const NeighbourLists& neighbours, Real dt,
                            FluidExchange* fluid = nullptr);
+    /// The same with the pairs built beforehand (pairs()), which stay valid while positions
+    /// within a fragment, volumes, porosities and tensors (up to rotation) do not change.
+    PoreFlowReport advance(PorousParticles& particles, const PorePairs& pairs, Real dt, FluidExchange* fluid = nullptr);
+
+    /// The candidate pairs with a non-zero conductance, `selection` of them.
+    PorePairs pairs(const PorousParticles& particles, const NeighbourLists& candidates,
+                    PairSelection selection = PairSelection::All);
 
     /// Net pore-water rate into each particle (kg/s) at the current state, for tests.
     void rates(const PorousParticles& particles, const NeighbourLists& neighbours, std::vector<Real>& rate);
@@ -58,14 +81,15 @@ private:
     Real pair_conductance(const PorousParticles& particles, Index lo, Index hi) const;
     /// Conductance of porous k with a fluid particle of volume m / rho0 at offset x (M15, fluid pair).
     Real fluid_conductance(const PorousParticles& particles, Index k, const Vec3& x, Real m) const;
-    /// Every pair's conductance in the slots of the neighbour lists, and their sum per particle.
-    void cache_conductances(const PorousParticles& particles, const NeighbourLists& neighbours, const FluidExchange* fluid);
+    /// Each fluid pair's conductance in the slots of fluid.porous_fluid, and the sum of all a
+    /// porous particle's conductances (for the sub-step limit).
+    void cache_conductances(const PorousParticles& particles, const PorePairs& pairs, const FluidExchange* fluid);
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
     Real pair_flux(const PorousParticles& particles, Index i, Index j, Real conductance) const;
-    /// Calls f(q_{j->i}) for every listed neighbour j of i.
+    /// Calls f(q_{j->i}) for every partner j of i.
     template <class F>
-    void for_each_pair(const PorousParticles& particles, const NeighbourLists& neighbours, Index i, const F& f) const;
+    void for_each_pair(const PorousParticles& particles, const PorePairs& pairs, Index i, const F& f) const;
     /// Flux into each porous particle from each listed fluid particle (kg/s), in the slots of
     /// fluid.porous_fluid, with the current limiter scales.
     void fluid_pair_fluxes(const PorousParticles& particles, const FluidExchange& fluid);
@@ -75,10 +99,11 @@ private:
     std::vector<Mat3> m_G;
     std::vector<Real> m_det_g, m_mobility, m_saturation, m_potential, m_outflow_scale;
     std::vector<Real> m_relative_permeability;  ///< k_r = min(S, 1)^beta per particle
+    std::vector<char> m_wet;                    ///< S > 1e-6 or touching fluid (empty: all)
     std::vector<Real> m_fluid_potential;                 ///< per fluid particle, Pa
     std::vector<Real> m_fluid_donor_scale, m_fluid_receiver_scale;  ///< per fluid particle, limiter
     std::vector<Real> m_fluid_flux, m_fluid_transfer;    ///< per porous-fluid slot: kg/s, kg this step
-    std::vector<Real> m_conductance, m_fluid_conductance;  ///< per list slot, kg/(s Pa)
+    std::vector<Real> m_fluid_conductance;               ///< per porous-fluid slot, kg/(s Pa)
     std::vector<Real> m_conductance_sum;                 ///< per porous particle, kg/(s Pa)
 };
 

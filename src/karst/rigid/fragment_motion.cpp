@@ -80,6 +80,7 @@ void advance_fragments(const Model& model, State& state, Real dt) {
         state.porous.removed += p.size() - kept;
         p.keep(inside);
         keep_flagged(s.exposed, inside);
+        s.pairs_stale = true;
         refresh_fragment_mass(state, model.dx);
     }
 }

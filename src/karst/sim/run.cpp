@@ -150,6 +150,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                       {"absorbed_initial", initial.absorbed}, {"absorbed_final", final_totals.absorbed},
                       {"solute_initial", initial.solute}, {"solute_final", final_totals.solute},
                       {"grains_initial", initial.grains}, {"grains_final", final_totals.grains}}},
+            {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
             {"max_density_error", max_density_error},
             {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
             {"threads", ThreadLimit::active_threads()},

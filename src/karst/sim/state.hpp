@@ -2,6 +2,7 @@
 // The mutable state (style.md P3/P4): fluid particles as one array per attribute, the time, and
 // per-step derived data (neighbour lists, accelerations) kept apart from the physical state.
 #include "karst/core/types.hpp"
+#include "karst/porous/pore_flow.hpp"
 #include "karst/porous/pore_water.hpp"
 #include "karst/rigid/fragment.hpp"
 #include "karst/sph/neighbour_grid.hpp"
@@ -62,21 +63,26 @@ struct PorousState {
     Index dissolved = 0;              ///< porous particles turned into muddy fluid (§4.8)
     Index fluid_deleted = 0;          ///< drained fluid particles deleted (§4.7.3)
     Index removed = 0;                ///< porous particles that left the domain
+    Index pore_substeps = 0;          ///< pore-flow sub-steps taken (§4.7.5), summed over steps
     Index size() const { return particles.size(); }
 };
 
 /// Porous data rebuilt every step.
 struct PorousScratch {
     CellRanges cells;                 ///< porous particles in the SPH grid (cell h)
-    CellRanges reach_cells;           ///< porous particles in the pore-flow grid (cell = kernel reach)
-    CellRanges fluid_reach_cells;     ///< fluid particles in the pore-flow grid
-    NeighbourLists porous_porous;     ///< within the kernel reach (M13), self excluded
+    CellRanges fluid_reach_cells;     ///< fluid particles in the pore-flow grid (cell = kernel reach)
+    NeighbourLists porous_porous;     ///< within h, self excluded
     NeighbourLists porous_fluid;      ///< fluid within the kernel reach
     NeighbourLists porous_wall;       ///< wall particles within h
     std::vector<Real> psi;            ///< Psi_k = rho0 V_k of this step (§4.1), kg
     std::vector<Vec3> force;          ///< fluid reactions and contact forces of this step, N
     std::vector<char> exposed;        ///< per porous particle: a fluid particle lies within h (may dissolve)
     Index contacts = 0;               ///< touching pairs of this step
+    /// Pore-flow pairs within each fragment (M15/M16). Rigid motion changes neither a pair's
+    /// distance nor its weight in the rotating kernel metric, so they are built once and again
+    /// only when the porous particles change (`pairs_stale`).
+    PorePairs fragment_pairs;
+    bool pairs_stale = true;
 };
 
 struct State {

@@ -46,13 +46,28 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     fluid.pressure = &state.fluid.p, fluid.porous_fluid = &state.porous_scratch.porous_fluid;
     fluid.full_mass = model.particle_mass;
     PoreFlow flow(model.pore_laws, model.h, model.dx);
-    const PoreFlowReport report = flow.advance(porous.particles, state.porous_scratch.porous_porous, dt, &fluid);
+    PorousScratch& s = state.porous_scratch;
+    if (s.pairs_stale) {
+        CellRanges cells;
+        NeighbourLists candidates;
+        sort_into_cells(model.porous_grid, porous.particles.x, cells);
+        find_neighbours(model.porous_grid, porous.particles.x, cells, true, candidates);
+        s.fragment_pairs = flow.pairs(porous.particles, candidates, PairSelection::SameFragment);
+        s.pairs_stale = false;
+    }
+    // Fragments in contact exchange water too (r < 1.1 dx), through pairs found anew each step.
+    const bool several = state.porous.fragments.size() > 1;
+    const PoreFlowReport report =
+        several ? flow.advance(porous.particles,
+                               merge_pairs(s.fragment_pairs, flow.pairs(porous.particles, s.porous_porous, PairSelection::AcrossFragments)),
+                               dt, &fluid)
+                : flow.advance(porous.particles, s.fragment_pairs, dt, &fluid);
     porous.absorbed += report.absorbed;
+    porous.pore_substeps += report.substeps;
     porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, fluid.main_receiver,
                                                   state.scratch.fluid_fluid, model.particle_mass);
     // Which porous particles may dissolve (porous/dissolution.hpp), while the lists hold: fluid
     // lies within h, and none closer than 0.6 dx.
-    PorousScratch& s = state.porous_scratch;
     const std::vector<Vec3>& x = porous.particles.x;
     const Real touch = model.h * model.h, crowd = 0.36 * model.dx * model.dx;
     s.exposed.assign(x.size(), 0);
@@ -73,6 +88,7 @@ void dissolve_particles(const Model& model, State& state) {
     const DissolutionReport r =
         dissolve(state.porous.particles, state.fluid, model.pore_laws, settings, state.next_id, state.porous_scratch.exposed);
     state.porous.dissolved += r.dissolved;
+    if (r.dissolved > 0) state.porous_scratch.pairs_stale = true;
 }
 
 }  // namespace
