@@ -1,10 +1,12 @@
-// The standard comparison case (issue 2): a 0.98 m cube of water (117,649 particles at 0.02 m)
-// at one end of a closed 4 x 3 x 1.5 m box, fixed 1 ms step, PCISPH with at most 1 % density
-// error and at least 3 iterations. Warms up, then times a batch of steps and prints
-// particle-steps per second, MIPPS, seconds per stage and density errors; appends CSV to
-// bench/results/<machine>/bench_dam_break_118k.csv.
+// Scene benchmarks with a fixed 1 ms step. The default is the standard comparison case (issue
+// 2): a 0.98 m cube of water (117,649 particles at 0.02 m) at one end of a closed 4 x 3 x 1.5 m
+// box, PCISPH with at most 1 % density error and at least 3 iterations. `--scene
+// bench_soak_100k` is issue 3's soak: 50,000 water particles resting on a layered porous block
+// of 51,000. Warms up, then times a batch of steps and prints particle-steps per second (fluid
+// and porous), MIPPS, seconds per stage and density errors; appends CSV to
+// bench/results/2core/<scene>.csv.
 //
-//   karst_bench_scene [--steps N] [--warmup N] [--threads N]
+//   karst_bench_scene [--scene NAME] [--steps N] [--warmup N] [--threads N]
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/scene/scene.hpp"
@@ -24,13 +26,15 @@ using namespace karst;
 
 int main(int argc, char** argv) {
     int steps = 50, warmup = 10, threads = 0;
+    std::string scene = "bench_dam_break_118k";
     for (int a = 1; a + 1 < argc; a += 2) {
-        if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
+        if (!std::strcmp(argv[a], "--scene")) scene = argv[a + 1];
+        else if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
         else if (!std::strcmp(argv[a], "--warmup")) warmup = std::atoi(argv[a + 1]);
         else if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
     }
     ThreadLimit limit(threads);
-    const std::string scene_path = std::string(KARST_SOURCE_DIR) + "/scenes/bench_dam_break_118k.json";
+    const std::string scene_path = std::string(KARST_SOURCE_DIR) + "/scenes/" + scene + ".json";
     const Model model = build_model(load_scene_file(scene_path));
     State state = make_initial_state(model);
     const Real dt = *model.scene.time.fixed_dt;
@@ -43,7 +47,7 @@ int main(int argc, char** argv) {
     double particle_steps = 0;
     Stopwatch watch;
     for (int k = 0; k < steps; ++k) {
-        particle_steps += double(state.fluid.size());
+        particle_steps += double(state.fluid.size() + state.porous.size());
         const StepReport r = step(model, state, dt, profile);
         errors.push_back(r.max_density_error);
         iterations += r.pressure_iterations;
@@ -53,8 +57,11 @@ int main(int argc, char** argv) {
     const double mean_error = [&] { double s = 0; for (Real e : errors) s += e; return s / errors.size(); }();
     const Real p99 = errors[std::min(errors.size() - 1, size_t(0.99 * errors.size()))];
 
-    fmt::print("karst_bench_scene: {} fluid + {} boundary particles, {} threads, {} steps after {} warm-up\n",
-               state.fluid.size(), model.walls.size(), ThreadLimit::active_threads(), steps, warmup);
+    fmt::print("karst_bench_scene {}: {} fluid + {} porous + {} boundary particles, {} threads, {} steps after {} warm-up\n",
+               scene, state.fluid.size(), state.porous.size(), model.walls.size(), ThreadLimit::active_threads(), steps, warmup);
+    if (state.porous.size() > 0)
+        fmt::print("  {:.3f} kg absorbed, {} pore-flow sub-steps per step\n", state.porous.absorbed,
+                   double(state.porous.pore_substeps) / (steps + warmup));
     fmt::print("  {:.0f} particle-steps/s, {:.4f} MIPPS, {:.1f} ms per step, {:.2f} PCISPH iterations per step\n",
                particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps, double(iterations) / steps);
     fmt::print("  max density error per step: mean {:.4f} %, p99 {:.4f} %, max {:.4f} %\n", 100 * mean_error,
@@ -66,7 +73,7 @@ int main(int argc, char** argv) {
     gethostname(host, sizeof host - 1);
     const std::filesystem::path dir = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core";
     std::filesystem::create_directories(dir);
-    const auto file = dir / "bench_dam_break_118k.csv";
+    const auto file = dir / (scene + ".csv");
     const bool fresh = !std::filesystem::exists(file);
     std::ofstream csv(file, std::ios::app);
     if (fresh) {
@@ -75,7 +82,7 @@ int main(int argc, char** argv) {
         csv << "\n";
     }
     csv << fmt::format("{},{},{},{:.0f},{:.5f},{:.2f},{:.2f},{:.5f},{:.5f}", ThreadLimit::active_threads(), steps,
-                       state.fluid.size(), particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps,
+                       state.fluid.size() + state.porous.size(), particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps,
                        double(iterations) / steps, mean_error, p99);
     for (double s : profile.seconds) csv << fmt::format(",{:.5f}", s / steps);
     csv << "\n";

@@ -9,8 +9,7 @@ void update_porous_neighbours(const Model& model, State& state) {
     find_neighbours(model.grid, state.fluid.x, s.cells, false, state.scratch.fluid_porous);
     find_neighbours(model.grid, x, model.walls.cells, false, s.porous_wall);
     find_neighbours(model.grid, x, s.cells, true, s.porous_porous);
-    sort_into_cells(model.porous_grid, state.fluid.x, s.fluid_reach_cells);
-    find_neighbours(model.porous_grid, x, s.fluid_reach_cells, false, s.porous_fluid);
+    find_neighbours(model.grid, x, state.scratch.cells, false, s.porous_fluid);
 }
 
 }  // namespace karst

@@ -14,10 +14,11 @@ PoreFlow::PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing)
     KARST_CHECK(!m_laws.empty());
 }
 
-void PoreFlow::refresh_metric(const PorousParticles& p) {
+void PoreFlow::refresh_metric(const PorousParticles& p, const NeighbourLists* only_with) {
     const Index n = p.size();
     m_G.resize(n), m_det_g.resize(n), m_mobility.resize(n);
     parallel_for(n, [&](Index i) {
+        if (only_with && only_with->count[i] == 0) return;
         const KernelMetric metric = kernel_metric(p.permeability[i], m_h);
         m_G[i] = metric.G, m_det_g[i] = metric.det_g, m_mobility[i] = metric.k_ref / law(p, i).darcy_viscosity;
     });
@@ -75,13 +76,16 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
     out.start.assign(n + 1, 0);
     for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + kept[i];
     out.other.resize(out.start[n]), out.conductance.resize(out.start[n]);
+    out.row_sum.resize(n);
     parallel_for(n, [&](Index i) {
         Index at = out.start[i];
         int s = 0;
+        Real sum = 0;
         candidates.for_each(i, [&](Index j) {
             const Real value = c[i * cap + s++];
-            if (value > 0) out.other[at] = j, out.conductance[at++] = value;
+            if (value > 0) out.other[at] = j, out.conductance[at++] = value, sum += value;
         });
+        out.row_sum[i] = sum;
     });
     return out;
 }
@@ -105,8 +109,9 @@ void PoreFlow::cache_conductances(const PorousParticles& p, const PorePairs& pai
     m_fluid_conductance.resize(size_t(n) * cap_f);
     m_conductance_sum.resize(n);
     parallel_for(n, [&](Index i) {
-        Real sum = 0;
-        for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) sum += pairs.conductance[s];
+        Real sum = pairs.row_sum.empty() ? 0 : pairs.row_sum[i];
+        if (pairs.row_sum.empty())
+            for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) sum += pairs.conductance[s];
         if (fluid) {
             int s = 0;
             fluid->porous_fluid->for_each(i, [&](Index f) {
@@ -186,8 +191,9 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
                 f(k, Index(fluid->porous_fluid->index[k * cap + s]), size_t(k * cap + s));
     };
     // Positions, tensors and volumes hold for the whole step: the pair conductances are
-    // computed once, and each sub-step only re-reads S and Phi.
-    refresh_metric(p);
+    // computed once, and each sub-step only re-reads S and Phi. The kernel metric is needed
+    // only where fluid partners are (the porous pairs came with their conductances).
+    if (fluid) refresh_metric(p, fluid->porous_fluid);
     cache_conductances(p, neighbours, fluid);
     if (fluid) {
         // Phi_f = max(p, 0) - rho0 g.x (M6); the fluid pressure is this step's and stays fixed.

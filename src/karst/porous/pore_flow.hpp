@@ -27,7 +27,7 @@ struct FluidExchange {
     std::vector<Real>* sph_mass = nullptr;         ///< rho0 V, kg (grows with the mass on back-flow)
     const std::vector<Real>* solute = nullptr;     ///< solute masses, kg: water is m - m_sol - drained
     const std::vector<Real>* pressure = nullptr;   ///< PCISPH pressure of this step, Pa
-    const NeighbourLists* porous_fluid = nullptr;  ///< per porous particle: fluid within kernel reach
+    const NeighbourLists* porous_fluid = nullptr;  ///< per porous particle: its fluid partners
     Real full_mass = 0;                            ///< m_f0: no transfer fills a fluid particle beyond it, kg
     /// Out, per fluid particle: the porous particle that received most of its water this step
     /// (-1 when none), for the deletion of drained particles.
@@ -41,6 +41,7 @@ struct PorePairs {
     std::vector<Index> start{0};
     std::vector<Index> other;
     std::vector<Real> conductance;
+    std::vector<Real> row_sum;  ///< sum of each row's conductances (empty: summed when needed)
     Index rows() const { return Index(start.size()) - 1; }
 };
 
@@ -72,8 +73,9 @@ public:
 
 private:
     const PoreWaterLaw& law(const PorousParticles& p, Index i) const { return m_laws[p.material_of(i)]; }
-    /// Per particle: G (M13), det G and the mobility k_ref / eta.
-    void refresh_metric(const PorousParticles& particles);
+    /// Per particle (those with partners in `only_with`, if given): G (M13), det G and the
+    /// mobility k_ref / eta.
+    void refresh_metric(const PorousParticles& particles, const NeighbourLists* only_with = nullptr);
     /// Per particle: S (M3), Phi (M6) and k_r; limiter scales back to 1.
     void refresh_state(const PorousParticles& particles);
     /// rho0 V_lo V_hi (k/eta)_pair F c_eps / h^2 of M15/M16 (lo < hi), kg/(s Pa) without k_r;

@@ -7,6 +7,7 @@
 #include "karst/rigid/fragment.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 
+#include <optional>
 #include <vector>
 
 namespace karst {
@@ -70,9 +71,8 @@ struct PorousState {
 /// Porous data rebuilt every step.
 struct PorousScratch {
     CellRanges cells;                 ///< porous particles in the SPH grid (cell h)
-    CellRanges fluid_reach_cells;     ///< fluid particles in the pore-flow grid (cell = kernel reach)
     NeighbourLists porous_porous;     ///< within h, self excluded
-    NeighbourLists porous_fluid;      ///< fluid within the kernel reach
+    NeighbourLists porous_fluid;      ///< fluid within h
     NeighbourLists porous_wall;       ///< wall particles within h
     std::vector<Real> psi;            ///< Psi_k = rho0 V_k of this step (§4.1), kg
     std::vector<Vec3> force;          ///< fluid reactions and contact forces of this step, N
@@ -83,6 +83,7 @@ struct PorousScratch {
     /// only when the porous particles change (`pairs_stale`).
     PorePairs fragment_pairs;
     bool pairs_stale = true;
+    std::optional<PoreFlow> flow;     ///< kept between steps for its buffers
 };
 
 struct State {

@@ -45,8 +45,9 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     fluid.solute = &state.fluid.solute;
     fluid.pressure = &state.fluid.p, fluid.porous_fluid = &state.porous_scratch.porous_fluid;
     fluid.full_mass = model.particle_mass;
-    PoreFlow flow(model.pore_laws, model.h, model.dx);
     PorousScratch& s = state.porous_scratch;
+    if (!s.flow) s.flow.emplace(model.pore_laws, model.h, model.dx);
+    PoreFlow& flow = *s.flow;
     if (s.pairs_stale) {
         CellRanges cells;
         NeighbourLists candidates;
