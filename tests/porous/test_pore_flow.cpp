@@ -240,5 +240,47 @@ TEST(PoreFlow, CapillaryWettingFrontAdvancesLikeSquareRootOfTime) {
     EXPECT_NEAR(n, 0.5, 0.1) << "fronts " << fronts[0] << " " << fronts[1] << " " << fronts[2] << " " << fronts[3] << " m";
 }
 
+// The paper's Eq. 20 in its conservative form (method.md §9 item 7, /pore_flow/pair_flux):
+// water is kept to round-off and a wet ball spreads, but the flux follows only differences of
+// m_p / V: in a uniformly wet block under gravity nothing moves, while the Darcy flux M15
+// drains the water downwards.
+TEST(PoreFlow, PaperEq20KeepsWaterButIgnoresGravityUnlikeDarcy) {
+    ThreadLimit one(1);
+    PoreWaterLaw law;  // gravity on, method.md §8.2 defaults
+    auto uniform_block = [&](PairFlux flux, std::vector<Real>& before) {
+        Block b = lattice_block(9, Mat3::Identity(), Mat3::Identity() * k_k0);
+        PorousParticles& p = b.particles;
+        for (Index i = 0; i < p.size(); ++i) p.absorbed_mass[i] = 0.6 * 1000 * k_phi * p.volume[i];
+        before = p.absorbed_mass;
+        PoreFlow flow({law}, k_h, k_dx, flux);
+        for (int step = 0; step < 20; ++step) flow.advance(p, b.neighbours, 0.025);
+        Real m = 0, z = 0;
+        for (Index i = 0; i < p.size(); ++i) m += p.absorbed_mass[i], z += p.absorbed_mass[i] * p.x[i][2];
+        return std::tuple{p.absorbed_mass, z / m};
+    };
+    std::vector<Real> before;
+    const auto [darcy_mass, darcy_z] = uniform_block(PairFlux::Darcy, before);
+    EXPECT_LT(darcy_z, -0.1 * k_dx) << "m: M15 lets the water sink (centre of the block at 0)";
+    const auto [paper_mass, paper_z] = uniform_block(PairFlux::PaperEq20, before);
+    for (size_t i = 0; i < before.size(); ++i) ASSERT_NEAR(paper_mass[i], before[i], 1e-12 * before[i]) << "Eq. 20 moves nothing";
+
+    // Without gravity, a wet ball in a dry block spreads and keeps its water.
+    law.gravity = Vec3::Zero();
+    Block b = lattice_block(13, Mat3::Identity(), Mat3::Identity() * k_k0);
+    PorousParticles& p = b.particles;
+    for (Index i = 0; i < p.size(); ++i) p.absorbed_mass[i] = (p.x[i].norm() < 2.6 * k_dx ? 1000 * k_phi * p.volume[i] : 0);
+    auto moments = [&] {
+        Real m = 0, r2 = 0;
+        for (Index i = 0; i < p.size(); ++i) m += p.absorbed_mass[i], r2 += p.absorbed_mass[i] * p.x[i].squaredNorm();
+        return std::pair{m, r2 / m};
+    };
+    const auto [m0, spread0] = moments();
+    PoreFlow flow({law}, k_h, k_dx, PairFlux::PaperEq20);
+    for (int step = 0; step < 20; ++step) flow.advance(p, b.neighbours, 0.01);
+    const auto [m1, spread1] = moments();
+    EXPECT_NEAR(m1, m0, 1e-12 * m0);
+    EXPECT_GT(spread1, 1.2 * spread0) << "m^2: the ball spreads";
+}
+
 }  // namespace
 }  // namespace karst

@@ -138,7 +138,8 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
     CellRanges cells;
     sort_into_cells(grid, p.x, cells);
     find_neighbours(grid, p.x, cells, true, m_pairs);
-    m_flow = std::make_unique<PoreFlow>(std::vector{m_law}, model.h, model.dx);
+    m_flow = std::make_unique<PoreFlow>(std::vector{m_law}, model.h, model.dx,
+                                        model.scene.paper_eq20 ? PairFlux::PaperEq20 : PairFlux::Darcy);
 }
 
 BiotCallReport PoroelasticSolid::advance(Real dt, PfemTimings& timings) {

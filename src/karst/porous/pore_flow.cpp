@@ -4,13 +4,14 @@
 #include "karst/core/parallel.hpp"
 #include "karst/porous/anisotropic_kernel.hpp"
 #include "karst/porous/permeability.hpp"
+#include "karst/sph/kernels.hpp"
 
 #include <cmath>
 
 namespace karst {
 
-PoreFlow::PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing)
-    : m_laws(std::move(laws)), m_h(h), m_spacing(spacing), m_calibration(pair_weight_calibration()) {
+PoreFlow::PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing, PairFlux flux)
+    : m_laws(std::move(laws)), m_h(h), m_spacing(spacing), m_calibration(pair_weight_calibration()), m_flux(flux) {
     KARST_CHECK(!m_laws.empty());
 }
 
@@ -75,7 +76,7 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
     PorePairs out;
     out.start.assign(n + 1, 0);
     for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + kept[i];
-    out.other.resize(out.start[n]), out.conductance.resize(out.start[n]);
+    out.other.resize(out.start[n]), out.conductance.resize(out.start[n]), out.weight.resize(out.start[n]);
     out.row_sum.resize(n);
     parallel_for(n, [&](Index i) {
         Index at = out.start[i];
@@ -83,7 +84,12 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
         Real sum = 0;
         candidates.for_each(i, [&](Index j) {
             const Real value = c[i * cap + s++];
-            if (value > 0) out.other[at] = j, out.conductance[at++] = value, sum += value;
+            if (value > 0) {
+                const Vec3 x = p.x[std::min(i, j)] - p.x[std::max(i, j)];
+                const Index lo = std::min(i, j), hi = std::max(i, j);
+                out.weight[at] = 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
+                out.other[at] = j, out.conductance[at++] = value, sum += value;
+            }
         });
         out.row_sum[i] = sum;
     });
@@ -98,8 +104,10 @@ PorePairs merge_pairs(const PorePairs& a, const PorePairs& b) {
     out.other.reserve(out.start[n]), out.conductance.reserve(out.start[n]);
     for (Index i = 0; i < n; ++i)
         for (const PorePairs* set : {&a, &b})
-            for (Index s = set->start[i]; s < set->start[i + 1]; ++s)
+            for (Index s = set->start[i]; s < set->start[i + 1]; ++s) {
                 out.other.push_back(set->other[s]), out.conductance.push_back(set->conductance[s]);
+                out.weight.push_back(set->weight.empty() ? 0 : set->weight[s]);
+            }
     return out;
 }
 
@@ -155,11 +163,44 @@ void PoreFlow::fluid_pair_fluxes(const PorousParticles& p, const FluidExchange& 
     });
 }
 
+Real PoreFlow::paper_pair_flux(const PorousParticles& p, const PorePairs& pairs, Index i, Index s) const {
+    const Index j = pairs.other[s];
+    const Index lo = std::min(i, j), hi = std::max(i, j);
+    const Vec3 x = p.x[lo] - p.x[hi];
+    const Vec3 r = x / x.norm();
+    // d_ij = (|v_pi.r| S_i^beta + |v_pj.r| S_j^beta) / 2 >= 0 (method.md §9 item 7), in (lo, hi)
+    // order so both sides agree bitwise.
+    const Real d = 0.5 * (std::abs(m_pore_velocity[lo].dot(r)) * m_relative_permeability[lo] +
+                          std::abs(m_pore_velocity[hi].dot(r)) * m_relative_permeability[hi]);
+    const Real into_lo = d / m_h * p.volume[lo] * p.volume[hi] *
+                         (p.absorbed_mass[hi] / p.volume[hi] - p.absorbed_mass[lo] / p.volume[lo]) * pairs.weight[s];
+    const Index donor = into_lo > 0 ? hi : lo;
+    const Real q = into_lo * m_outflow_scale[donor];
+    return i == lo ? q : -q;
+}
+
+void PoreFlow::pore_velocities(const PorousParticles& p, const PorePairs& pairs, const std::vector<Index>& rows) {
+    // M17: v_p = -(k_r K / (phi eta)) grad Phi, grad Phi = sum_j V_j (Phi_j - Phi_i) grad W_ij.
+    const CubicKernel W(m_h);
+    m_pore_velocity.assign(p.size(), Vec3::Zero());
+    parallel_for(Index(rows.size()), [&](Index r) {
+        const Index i = rows[r];
+        if (p.porosity[i] < k_min_porosity) return;
+        Vec3 grad = Vec3::Zero();
+        for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) {
+            const Index j = pairs.other[s];
+            if (p.fragment[j] == p.fragment[i]) grad += p.volume[j] * (m_potential[j] - m_potential[i]) * W.gradient(p.x[i] - p.x[j]);
+        }
+        m_pore_velocity[i] = -(m_relative_permeability[i] / (p.porosity[i] * law(p, i).darcy_viscosity)) * (p.permeability[i] * grad);
+    });
+}
+
 template <class F>
 void PoreFlow::for_each_pair(const PorousParticles& p, const PorePairs& pairs, Index i, const F& f) const {
     for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) {
         const Index j = pairs.other[s];
-        if (m_wet.empty() || m_wet[i] || m_wet[j]) f(pair_flux(p, i, j, pairs.conductance[s]));
+        if (!(m_wet.empty() || m_wet[i] || m_wet[j])) continue;
+        f(m_flux == PairFlux::PaperEq20 ? paper_pair_flux(p, pairs, i, s) : pair_flux(p, i, j, pairs.conductance[s]));
     }
 }
 
@@ -227,12 +268,25 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         for (Index i = 0; i < n; ++i)
             if (active[i]) rows.push_back(i);
         const Index nr = Index(rows.size());
+        if (m_flux == PairFlux::PaperEq20) pore_velocities(p, neighbours, rows);
         // Sub-step limit (§4.7.5): explicit diffusion is stable for dt sum_j c_ij dPhi_i/dm_i <= 1;
         // half of that, with k_r = 1 as its upper bound. A fluid particle's Phi does not depend on
         // its mass, so only porous particles limit the step.
         const Real stiffness = parallel_max(nr, Real(0), [&](Index r) {
             const Index i = rows[r];
             if (p.porosity[i] < k_min_porosity) return Real(0);
+            if (m_flux == PairFlux::PaperEq20) {
+                // Eq. 20 diffuses m_p / V: stable for dt sum_j (d_ij / h) V_j F_ij <= 1, with
+                // d_ij <= (|v_pi| + |v_pj|) / 2; fluid pairs as for M15.
+                Real sum = 0;
+                for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s) {
+                    const Index j = neighbours.other[s];
+                    sum += 0.5 * (m_pore_velocity[i].norm() + m_pore_velocity[j].norm()) / m_h * p.volume[j] * neighbours.weight[s];
+                }
+                const PoreWaterLaw& l = law(p, i);
+                const Real fluid_sum = m_conductance_sum[i] - (neighbours.row_sum.empty() ? 0 : neighbours.row_sum[i]);
+                return sum + fluid_sum * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
+            }
             const PoreWaterLaw& l = law(p, i);
             return m_conductance_sum[i] * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
         });

@@ -41,9 +41,17 @@ struct PorePairs {
     std::vector<Index> start{0};
     std::vector<Index> other;
     std::vector<Real> conductance;
+    std::vector<Real> weight;   ///< F_ij of M16 (calibrated), 1/m^3, for the paper's Eq. 20
     std::vector<Real> row_sum;  ///< sum of each row's conductances (empty: summed when needed)
     Index rows() const { return Index(start.size()) - 1; }
 };
+
+/// The pair flux between porous particles: the Darcy flux M15 (default), or the paper's Eq. 20 in
+/// the conservative form of method.md §9 item 7, q_{j->i} = (d_ij / h) V_i V_j (m_pj / V_j -
+/// m_pi / V_i) F_ij with d_ij = (|v_pi.r| S_i^beta + |v_pj.r| S_j^beta) / 2 and v_p from M17. The
+/// latter diffuses m_p / V along the pore velocity: conservative and stable, but blind to
+/// gravity and capillarity as drivers. Fluid-porous pairs use M15 in both.
+enum class PairFlux { Darcy, PaperEq20 };
 
 /// Which candidate pairs a PorePairs keeps.
 enum class PairSelection { All, SameFragment, AcrossFragments };
@@ -57,7 +65,7 @@ class PoreFlow {
 public:
     /// `laws` per material (PorousParticles::material), `h` the isotropic support radius,
     /// `spacing` the particle spacing dx.
-    PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing);
+    PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing, PairFlux flux = PairFlux::Darcy);
     PoreFlowReport advance(PorousParticles& particles, const NeighbourLists& neighbours, Real dt,
                            FluidExchange* fluid = nullptr);
     /// The same with the pairs built beforehand (pairs()), which stay valid while positions
@@ -89,6 +97,10 @@ private:
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
     Real pair_flux(const PorousParticles& particles, Index i, Index j, Real conductance) const;
+    /// The paper's Eq. 20 (conservative form) for the pair in slot s of row i.
+    Real paper_pair_flux(const PorousParticles& particles, const PorePairs& pairs, Index i, Index s) const;
+    /// M17 pore velocities of the listed rows (for the paper's Eq. 20).
+    void pore_velocities(const PorousParticles& particles, const PorePairs& pairs, const std::vector<Index>& rows);
     /// Calls f(q_{j->i}) for every partner j of i.
     template <class F>
     void for_each_pair(const PorousParticles& particles, const PorePairs& pairs, Index i, const F& f) const;
@@ -98,6 +110,8 @@ private:
 
     std::vector<PoreWaterLaw> m_laws;
     Real m_h, m_spacing, m_calibration;
+    PairFlux m_flux;
+    std::vector<Vec3> m_pore_velocity;  ///< M17, m/s (paper's Eq. 20 only)
     std::vector<Mat3> m_G;
     std::vector<Real> m_det_g, m_mobility, m_saturation, m_potential, m_outflow_scale;
     std::vector<Real> m_relative_permeability;  ///< k_r = min(S, 1)^beta per particle

@@ -136,6 +136,7 @@ Scene parse_scene(const std::string& text) {
         }
         s.porous_solids.push_back(std::move(solid));
     }
+    s.paper_eq20 = doc["pore_flow"]["pair_flux"] == "paper_eq20";
     const json& pe = doc["poroelastic"];
     s.poroelastic.time_step = pe["time_step"], s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
     s.poroelastic.fixed_strain = pe["splitting"] == "fixed_strain";

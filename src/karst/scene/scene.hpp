@@ -129,6 +129,7 @@ struct Scene {
     std::vector<Wall> walls;
     std::vector<PorousSolid> porous_solids;
     PoroelasticSettings poroelastic;
+    bool paper_eq20 = false;       ///< /pore_flow/pair_flux: the paper's Eq. 20 instead of M15
     OutputSettings output;
     Real max_speed = 100;  ///< watchdog, m/s
     int sort_interval = 10;

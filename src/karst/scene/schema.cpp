@@ -179,6 +179,12 @@ std::vector<KeySpec> make_schema() {
         key("/porous_solids/[]/constraints/[]/traction", T::Vec3, "Pa", closed(-1e12, 1e12), zero3,
             "traction only: force per area on the surface (e.g. [0, 0, -1e4] presses down)."),
 
+        key("/pore_flow", T::Object, "", any(), json::object(), "Transport of pore water between porous particles (method.md §4.7)."),
+        key("/pore_flow/pair_flux", T::Enum, "", any(), "darcy",
+            "darcy: the conservative Darcy pair flux M15, driven by pore pressure, capillarity and gravity; "
+            "paper_eq20: the paper's Eq. 20 in its conservative form (method.md §9 item 7), which diffuses the "
+            "absorbed mass along the pore velocity and ignores gravity and capillarity as drivers, for comparison.",
+            {"darcy", "paper_eq20"}),
         key("/poroelastic", T::Object, "", any(), json::object(), "PFEM mesh and Biot solver (method.md §5)."),
         key("/poroelastic/time_step", T::Number, "s", positive(1e6), 1.0 / 30,
             "Biot step dt_B (one call per step; method.md §8.2: one per frame)."),

@@ -46,7 +46,7 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     fluid.pressure = &state.fluid.p, fluid.porous_fluid = &state.porous_scratch.porous_fluid;
     fluid.full_mass = model.particle_mass;
     PorousScratch& s = state.porous_scratch;
-    if (!s.flow) s.flow.emplace(model.pore_laws, model.h, model.dx);
+    if (!s.flow) s.flow.emplace(model.pore_laws, model.h, model.dx, model.scene.paper_eq20 ? PairFlux::PaperEq20 : PairFlux::Darcy);
     PoreFlow& flow = *s.flow;
     if (s.pairs_stale) {
         CellRanges cells;
