@@ -107,7 +107,7 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
       m_feedback(model.scene.poroelastic.permeability_feedback),
       m_pore_water(model.scene.poroelastic.pressure_from_pore_water),
       m_h(model.h),
-      m_body_tensors(body_permeabilities(m_scene.material, body.rest_x, model.h)),
+      m_body_tensors(body.body_permeability),
       m_law(pore_water_law(m_scene.material, model.rho0, model.scene.gravity)),
       m_mesh(mesh_body(model, body, timings)),
       m_solver(make_solver(model, body, m_mesh, m_body_tensors, timings)),
@@ -117,19 +117,9 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
     m_assembled_k.assign(m_mesh.tet_count(), m_scene.material.permeability);
 
     // The pore water on the particles (method.md §2, §4.7): the mesh nodes are the particles.
-    const PorousMaterial& mat = m_scene.material;
-    const Real V0 = model.dx * model.dx * model.dx;
-    PorousParticles& p = m_particles;
-    for (size_t i = 0; i < body.rest_x.size(); ++i) {
-        const Vec3& x = body.rest_x[i];
-        Real S = mat.initial_saturation;
-        for (const WetRegion& w : m_scene.wet_regions)
-            if (w.region.signed_distance(x) <= 0) S = w.saturation;
-        p.x.push_back(x), p.v.push_back(Vec3::Zero()), p.volume.push_back(V0), p.porosity.push_back(mat.porosity);
-        p.absorbed_mass.push_back(S * model.rho0 * mat.porosity * V0);
-        p.solid_mass.push_back(mat.solid_density * (1 - mat.porosity) * V0);
-        p.permeability.push_back(m_body_tensors[i]), p.fragment.push_back(body.solid);
-    }
+    m_particles = porous_particles_at_rest(model, body, body.solid);
+    m_particles.material.clear();  // one material: m_law
+    const PorousParticles& p = m_particles;
     Real reach = model.h;
     for (const Mat3& K : m_body_tensors) reach = std::max(reach, kernel_reach(K, model.h));
     Aabb box;

@@ -26,6 +26,13 @@ struct PorousParticles {
     std::vector<Mat3> body_permeability;  ///< K0 in the body frame (M12), m^2
     Index size() const { return Index(x.size()); }
     Index material_of(Index i) const { return material.empty() ? 0 : material[i]; }
+    /// Appends the particles of `other`.
+    void append(const PorousParticles& other) {
+        auto add = [](auto& a, const auto& b) { a.insert(a.end(), b.begin(), b.end()); };
+        add(x, other.x), add(volume, other.volume), add(porosity, other.porosity), add(absorbed_mass, other.absorbed_mass);
+        add(solid_mass, other.solid_mass), add(v, other.v), add(permeability, other.permeability), add(fragment, other.fragment);
+        add(rest, other.rest), add(material, other.material), add(body_permeability, other.body_permeability);
+    }
     /// Keeps the particles whose flag is set, in order.
     void keep(const std::vector<char>& flag) {
         keep_flagged(x, flag), keep_flagged(volume, flag), keep_flagged(porosity, flag), keep_flagged(absorbed_mass, flag);

@@ -34,4 +34,23 @@ std::vector<Mat3> body_permeabilities(const PorousMaterial& mat, const std::vect
     return K;
 }
 
+PorousParticles porous_particles_at_rest(const Model& model, const PorousBody& body, Index fragment) {
+    const PorousSolid& solid = model.scene.porous_solids[body.solid];
+    const PorousMaterial& mat = solid.material;
+    const Real V0 = model.dx * model.dx * model.dx;
+    PorousParticles p;
+    for (size_t i = 0; i < body.rest_x.size(); ++i) {
+        const Vec3& x = body.rest_x[i];
+        Real S = mat.initial_saturation;
+        for (const WetRegion& w : solid.wet_regions)
+            if (w.region.signed_distance(x) <= 0) S = w.saturation;
+        p.x.push_back(x), p.v.push_back(Vec3::Zero()), p.volume.push_back(V0), p.porosity.push_back(mat.porosity);
+        p.absorbed_mass.push_back(mat.porosity >= k_min_porosity ? S * model.rho0 * mat.porosity * V0 : 0);
+        p.solid_mass.push_back(mat.solid_density * (1 - mat.porosity) * V0);
+        p.permeability.push_back(body.body_permeability[i]), p.body_permeability.push_back(body.body_permeability[i]);
+        p.fragment.push_back(fragment), p.material.push_back(body.solid), p.rest.push_back(Vec3::Zero());
+    }
+    return p;
+}
+
 }  // namespace karst

@@ -2,6 +2,7 @@
 
 #include "karst/core/soa.hpp"
 #include "karst/sim/model.hpp"
+#include "karst/sim/porous_materials.hpp"
 
 namespace karst {
 
@@ -24,22 +25,10 @@ namespace {
 void make_porous(const Model& model, PorousState& porous) {
     if (!model.coupled()) return;
     PorousParticles& p = porous.particles;
-    const Real V0 = model.dx * model.dx * model.dx;
     for (const PorousBody& body : model.porous) {
         const PorousSolid& solid = model.scene.porous_solids[body.solid];
-        const PorousMaterial& mat = solid.material;
         const Index first = p.size(), fragment = Index(porous.fragments.size());
-        for (size_t i = 0; i < body.rest_x.size(); ++i) {
-            const Vec3& x = body.rest_x[i];
-            Real S = mat.initial_saturation;
-            for (const WetRegion& w : solid.wet_regions)
-                if (w.region.signed_distance(x) <= 0) S = w.saturation;
-            p.x.push_back(x), p.v.push_back(Vec3::Zero()), p.volume.push_back(V0), p.porosity.push_back(mat.porosity);
-            p.absorbed_mass.push_back(mat.porosity >= k_min_porosity ? S * model.rho0 * mat.porosity * V0 : 0);
-            p.solid_mass.push_back(mat.solid_density * (1 - mat.porosity) * V0);
-            p.permeability.push_back(body.body_permeability[i]), p.body_permeability.push_back(body.body_permeability[i]);
-            p.fragment.push_back(fragment), p.material.push_back(body.solid), p.rest.push_back(Vec3::Zero());
-        }
+        p.append(porous_particles_at_rest(model, body, fragment));
         const Index n = p.size() - first;
         std::vector<Real> mass(n);
         for (Index i = 0; i < n; ++i) mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];
