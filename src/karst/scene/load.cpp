@@ -105,6 +105,7 @@ Scene parse_scene(const std::string& text) {
         mat.tensile_strength = m["tensile_strength"];
         mat.capillary_pressure = m["capillary_pressure"], mat.capillary_exponent = m["capillary_exponent"];
         mat.pore_stiffness = m["pore_stiffness"], mat.saturation_exponent = m["saturation_exponent"];
+        mat.pore_exponent = m["pore_exponent"];
         mat.initial_saturation = m["initial_saturation"];
         mat.dissolution_porosity = m["dissolution_porosity"], mat.dissolution_saturation = m["dissolution_saturation"];
         mat.absorption_factor = m["absorption_factor"];

@@ -60,6 +60,7 @@ struct PorousMaterial {
     Real capillary_pressure = 2000;   ///< k^c, Pa
     Real capillary_exponent = 0.5;    ///< alpha
     Real pore_stiffness = 1.4e4;      ///< k^p, Pa
+    Real pore_exponent = 7;           ///< gamma of M5
     Real saturation_exponent = 2;     ///< beta
     Real initial_saturation = 0;
     enum class Layering { Bedding, Fibre, FromGeometry };

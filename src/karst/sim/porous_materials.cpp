@@ -11,6 +11,7 @@ PoreWaterLaw pore_water_law(const PorousMaterial& mat, Real rest_density, const 
     PoreWaterLaw law;
     law.rest_density = rest_density, law.capillary_scale = mat.capillary_pressure;
     law.capillary_exponent = mat.capillary_exponent, law.pore_stiffness = mat.pore_stiffness;
+    law.tait_exponent = mat.pore_exponent;
     law.saturation_exponent = mat.saturation_exponent, law.darcy_viscosity = mat.darcy_viscosity;
     law.gravity = gravity;
     law.absorption_factor = mat.absorption_factor;
