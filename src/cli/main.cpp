@@ -54,8 +54,13 @@ int main(int argc, char** argv) {
         }
         if (app.got_subcommand("check")) {
             const karst::Model model = karst::build_model(karst::load_scene_file(check_path));
-            fmt::print("scene '{}' is valid: {} fluid particles, {} boundary particles, spacing {} m, domain [{}, {}, {}] - [{}, {}, {}] m\n",
-                       model.scene.name, model.initial_x.size(), model.walls.size(), model.dx,
+            size_t porous = 0;
+            for (const karst::PorousBody& body : model.porous) porous += body.rest_x.size();
+            fmt::print("scene '{}' is valid: {} fluid particles, {} porous particles in {} solids ({}), {} boundary particles, "
+                       "spacing {} m, domain [{}, {}, {}] - [{}, {}, {}] m\n",
+                       model.scene.name, model.initial_x.size(), porous, model.porous.size(),
+                       model.porous.empty() ? "none" : model.coupled() ? "coupled with the fluid" : "poroelastic-only",
+                       model.walls.size(), model.dx,
                        model.domain.min[0], model.domain.min[1], model.domain.min[2],
                        model.domain.max[0], model.domain.max[1], model.domain.max[2]);
             return 0;
