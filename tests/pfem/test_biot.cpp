@@ -18,8 +18,6 @@ TetMesh box_mesh(const Vec3& lo, const Vec3& hi, Real dx) {
     return build_tet_mesh(nodes, std::vector<Real>(nodes.size(), dx), MeshOptions{});
 }
 
-bool near(Real a, Real b) { return std::abs(a - b) < 1e-9; }
-
 /// A problem with no pore pressure (all nodes drained at p = 0): pure elasticity.
 BiotProblem elastic_problem(const TetMesh& mesh, Real E, Real nu) {
     BiotProblem p;

@@ -48,13 +48,6 @@ void set_strain_displacement_columns(Matrix& B, int a, const Vec3& g) {
     B(5, c) = g[1], B(5, c + 1) = g[0];
 }
 
-/// Strain-displacement matrix B_u (6 x 12) of a P1 tet.
-Eigen::Matrix<Real, 6, 12> strain_displacement(const P1Tet& p) {
-    Eigen::Matrix<Real, 6, 12> B = Eigen::Matrix<Real, 6, 12>::Zero();
-    for (int a = 0; a < 4; ++a) set_strain_displacement_columns(B, a, p.grad[a]);
-    return B;
-}
-
 /// Splits the unknowns into free and prescribed ones: free_index[i] is the row in the reduced
 /// system, or -1 where the unknown is prescribed.
 struct DofSplit {

@@ -132,7 +132,7 @@ void PoreFlow::cache_conductances(const PorousParticles& p, const PorePairs& pai
     });
 }
 
-Real PoreFlow::pair_flux(const PorousParticles& p, Index i, Index j, Real conductance) const {
+Real PoreFlow::pair_flux(Index i, Index j, Real conductance) const {
     const Index lo = std::min(i, j), hi = std::max(i, j);
     const Real dphi = m_potential[hi] - m_potential[lo];
     if (dphi == 0 || conductance == 0) return 0;
@@ -200,7 +200,7 @@ void PoreFlow::for_each_pair(const PorousParticles& p, const PorePairs& pairs, I
     for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) {
         const Index j = pairs.other[s];
         if (!(m_wet.empty() || m_wet[i] || m_wet[j])) continue;
-        f(m_flux == PairFlux::PaperEq20 ? paper_pair_flux(p, pairs, i, s) : pair_flux(p, i, j, pairs.conductance[s]));
+        f(m_flux == PairFlux::PaperEq20 ? paper_pair_flux(p, pairs, i, s) : pair_flux(i, j, pairs.conductance[s]));
     }
 }
 

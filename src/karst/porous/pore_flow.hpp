@@ -96,7 +96,7 @@ private:
     void cache_conductances(const PorousParticles& particles, const PorePairs& pairs, const FluidExchange* fluid);
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
-    Real pair_flux(const PorousParticles& particles, Index i, Index j, Real conductance) const;
+    Real pair_flux(Index i, Index j, Real conductance) const;
     /// The paper's Eq. 20 (conservative form) for the pair in slot s of row i.
     Real paper_pair_flux(const PorousParticles& particles, const PorePairs& pairs, Index i, Index s) const;
     /// M17 pore velocities of the listed rows (for the paper's Eq. 20).
