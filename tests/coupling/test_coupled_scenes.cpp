@@ -212,7 +212,7 @@ TEST(Coupling, CaveSoakDemoSoaksAndKeepsItsWater) {
     auto water = [&] {
         Real sum = 0;
         const FluidParticles& f = sim.state.fluid;
-        for (Index i = 0; i < f.size(); ++i) sum += f.mass[i] - f.solute[i] - f.drained[i];
+        for (Index i = 0; i < f.size(); ++i) sum += f.water(i);
         for (Real m : sim.state.porous.particles.absorbed_mass) sum += m;
         return sum;
     };

@@ -39,7 +39,7 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         points.add_scalar("density", fluid.rho);
         points.add_scalar("pressure", fluid.p);
         std::vector<Real> water(fluid.size());  // absorption drains it, dissolution brings grains
-        for (Index i = 0; i < fluid.size(); ++i) water[i] = fluid.mass[i] - fluid.solute[i] - fluid.drained[i];
+        for (Index i = 0; i < fluid.size(); ++i) water[i] = fluid.water(i);
         points.add_scalar("water", water);
         std::vector<Real> concentration(fluid.size());
         for (Index i = 0; i < fluid.size(); ++i) concentration[i] = fluid.solute[i] / fluid.mass[i];

@@ -1,5 +1,7 @@
 #include "karst/porous/dissolution.hpp"
 
+#include "karst/core/parallel.hpp"
+
 #include <cmath>
 
 namespace karst {
@@ -13,6 +15,21 @@ Vec3 piece_offset(int piece, Real dx) {
 }
 
 }  // namespace
+
+void mark_exposed(const PorousParticles& porous, const FluidParticles& fluid, const NeighbourLists& porous_fluid, Real h,
+                  Real spacing, std::vector<char>& exposed) {
+    const Real touch = h * h, crowd = 0.36 * spacing * spacing;
+    exposed.assign(porous.size(), 0);
+    parallel_for(porous.size(), [&](Index k) {
+        bool wet = false, crowded = false;
+        porous_fluid.for_each(k, [&](Index i) {
+            if (fluid.mass[i] == 0) return;
+            const Real r2 = (fluid.x[i] - porous.x[k]).squaredNorm();
+            wet = wet || r2 < touch, crowded = crowded || r2 < crowd;
+        });
+        exposed[k] = wet && !crowded;
+    });
+}
 
 DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::span<const PoreWaterLaw> laws,
                            const DissolutionSettings& settings, std::int64_t& next_id, const std::vector<char>& exposed) {

@@ -10,7 +10,7 @@ Index drain_fluid_particles(FluidParticles& fluid, PorousParticles& porous, cons
     // Serial, in index order: a particle's solute may go to a neighbour drained later, which
     // then passes it on; the result does not depend on the thread count.
     for (Index i = 0; i < fluid.size(); ++i) {
-        const Real water = fluid.mass[i] - fluid.solute[i] - fluid.drained[i];
+        const Real water = fluid.water(i);
         if (fluid.mass[i] == 0 || water >= threshold * full_mass || main_receiver[i] < 0) continue;
         if (fluid.solute[i] > 0) {
             Index nearest = -1;

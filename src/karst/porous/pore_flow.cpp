@@ -37,16 +37,19 @@ void PoreFlow::refresh_state(const PorousParticles& p) {
     });
 }
 
-Real PoreFlow::pair_conductance(const PorousParticles& p, Index lo, Index hi) const {
+Real PoreFlow::pair_weight_between(const PorousParticles& p, Index lo, Index hi) const {
     if (p.porosity[lo] < k_min_porosity || p.porosity[hi] < k_min_porosity) return 0;  // impermeable (M3)
     const Vec3 x = p.x[lo] - p.x[hi];
     // Different fragments exchange water only in contact, so an open crack does not conduct.
     if (p.fragment[lo] != p.fragment[hi] && x.norm() >= 1.1 * m_spacing) return 0;
     // M16: the pair weight in the metric of both kernels, calibrated by c_eps.
-    const Real F = 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
+    return 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
+}
+
+Real PoreFlow::pair_conductance(const PorousParticles& p, Index lo, Index hi, Real weight) const {
     // M15: harmonic mean of the mobilities k / eta (of the permeabilities for one material).
     const Real mobility = 2 * m_mobility[lo] * m_mobility[hi] / (m_mobility[lo] + m_mobility[hi]);
-    return law(p, lo).rest_density * p.volume[lo] * p.volume[hi] * mobility / (m_h * m_h) * F;
+    return law(p, lo).rest_density * p.volume[lo] * p.volume[hi] * mobility / (m_h * m_h) * weight;
 }
 
 Real PoreFlow::fluid_conductance(const PorousParticles& p, Index k, const Vec3& x, Real m) const {
@@ -60,7 +63,7 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
     refresh_metric(p);
     const Index n = p.size();
     const int cap = candidates.capacity;
-    std::vector<Real> c(size_t(n) * cap, 0);
+    std::vector<Real> weight(size_t(n) * cap, 0);
     std::vector<Index> kept(n, 0);
     parallel_for(n, [&](Index i) {
         int s = 0;
@@ -68,9 +71,9 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
             const bool same = p.fragment[i] == p.fragment[j];
             const bool wanted = selection == PairSelection::All || (selection == PairSelection::SameFragment) == same;
             // (min, max) order: both sides of a pair hold bitwise the same value.
-            const Real value = wanted ? pair_conductance(p, std::min(i, j), std::max(i, j)) : 0;
-            c[i * cap + s++] = value;
-            kept[i] += value > 0;
+            const Real w = wanted ? pair_weight_between(p, std::min(i, j), std::max(i, j)) : 0;
+            weight[i * cap + s++] = w;
+            kept[i] += w > 0;
         });
     });
     PorePairs out;
@@ -83,13 +86,10 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
         int s = 0;
         Real sum = 0;
         candidates.for_each(i, [&](Index j) {
-            const Real value = c[i * cap + s++];
-            if (value > 0) {
-                const Vec3 x = p.x[std::min(i, j)] - p.x[std::max(i, j)];
-                const Index lo = std::min(i, j), hi = std::max(i, j);
-                out.weight[at] = 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
-                out.other[at] = j, out.conductance[at++] = value, sum += value;
-            }
+            const Real w = weight[i * cap + s++];
+            if (w == 0) return;
+            const Real c = pair_conductance(p, std::min(i, j), std::max(i, j), w);
+            out.other[at] = j, out.weight[at] = w, out.conductance[at++] = c, sum += c;
         });
         out.row_sum[i] = sum;
     });
@@ -101,34 +101,33 @@ PorePairs merge_pairs(const PorePairs& a, const PorePairs& b) {
     const Index n = a.rows();
     out.start.assign(n + 1, 0);
     for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + (a.start[i + 1] - a.start[i]) + (b.start[i + 1] - b.start[i]);
-    out.other.reserve(out.start[n]), out.conductance.reserve(out.start[n]);
-    for (Index i = 0; i < n; ++i)
+    out.other.reserve(out.start[n]), out.conductance.reserve(out.start[n]), out.weight.reserve(out.start[n]);
+    out.row_sum.resize(n);
+    for (Index i = 0; i < n; ++i) {
         for (const PorePairs* set : {&a, &b})
             for (Index s = set->start[i]; s < set->start[i + 1]; ++s) {
                 out.other.push_back(set->other[s]), out.conductance.push_back(set->conductance[s]);
-                out.weight.push_back(set->weight.empty() ? 0 : set->weight[s]);
+                out.weight.push_back(set->weight[s]);
             }
+        out.row_sum[i] = a.row_sum[i] + b.row_sum[i];
+    }
     return out;
 }
 
-void PoreFlow::cache_conductances(const PorousParticles& p, const PorePairs& pairs, const FluidExchange* fluid) {
+void PoreFlow::cache_fluid_conductances(const PorousParticles& p, const FluidExchange& fluid) {
     const Index n = p.size();
-    const int cap_f = fluid ? fluid->porous_fluid->capacity : 0;
-    m_fluid_conductance.resize(size_t(n) * cap_f);
-    m_conductance_sum.resize(n);
+    const int cap = fluid.porous_fluid->capacity;
+    m_fluid_conductance.resize(size_t(n) * cap);
+    m_fluid_conductance_sum.resize(n);
     parallel_for(n, [&](Index i) {
-        Real sum = pairs.row_sum.empty() ? 0 : pairs.row_sum[i];
-        if (pairs.row_sum.empty())
-            for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) sum += pairs.conductance[s];
-        if (fluid) {
-            int s = 0;
-            fluid->porous_fluid->for_each(i, [&](Index f) {
-                const Real c = fluid_conductance(p, i, (*fluid->x)[f] - p.x[i], (*fluid->sph_mass)[f]);
-                m_fluid_conductance[i * cap_f + s++] = c;
-                sum += c;
-            });
-        }
-        m_conductance_sum[i] = sum;
+        Real sum = 0;
+        int s = 0;
+        fluid.porous_fluid->for_each(i, [&](Index f) {
+            const Real c = fluid_conductance(p, i, (*fluid.x)[f] - p.x[i], (*fluid.sph_mass)[f]);
+            m_fluid_conductance[i * cap + s++] = c;
+            sum += c;
+        });
+        m_fluid_conductance_sum[i] = sum;
     });
 }
 
@@ -191,7 +190,7 @@ void PoreFlow::pore_velocities(const PorousParticles& p, const PorePairs& pairs,
             const Index j = pairs.other[s];
             if (p.fragment[j] == p.fragment[i]) grad += p.volume[j] * (m_potential[j] - m_potential[i]) * W.gradient(p.x[i] - p.x[j]);
         }
-        m_pore_velocity[i] = -(m_relative_permeability[i] / (p.porosity[i] * law(p, i).darcy_viscosity)) * (p.permeability[i] * grad);
+        m_pore_velocity[i] = law(p, i).pore_velocity(m_relative_permeability[i], p.porosity[i], p.permeability[i], grad);
     });
 }
 
@@ -234,9 +233,10 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
     // Positions, tensors and volumes hold for the whole step: the pair conductances are
     // computed once, and each sub-step only re-reads S and Phi. The kernel metric is needed
     // only where fluid partners are (the porous pairs came with their conductances).
-    if (fluid) refresh_metric(p, fluid->porous_fluid);
-    cache_conductances(p, neighbours, fluid);
+    m_fluid_conductance_sum.assign(n, 0);
     if (fluid) {
+        refresh_metric(p, fluid->porous_fluid);
+        cache_fluid_conductances(p, *fluid);
         // Phi_f = max(p, 0) - rho0 g.x (M6); the fluid pressure is this step's and stays fixed.
         m_fluid_potential.resize(nf);
         const PoreWaterLaw& l = m_laws[0];
@@ -275,20 +275,17 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         const Real stiffness = parallel_max(nr, Real(0), [&](Index r) {
             const Index i = rows[r];
             if (p.porosity[i] < k_min_porosity) return Real(0);
-            if (m_flux == PairFlux::PaperEq20) {
-                // Eq. 20 diffuses m_p / V: stable for dt sum_j (d_ij / h) V_j F_ij <= 1, with
-                // d_ij <= (|v_pi| + |v_pj|) / 2; fluid pairs as for M15.
-                Real sum = 0;
-                for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s) {
-                    const Index j = neighbours.other[s];
-                    sum += 0.5 * (m_pore_velocity[i].norm() + m_pore_velocity[j].norm()) / m_h * p.volume[j] * neighbours.weight[s];
-                }
-                const PoreWaterLaw& l = law(p, i);
-                const Real fluid_sum = m_conductance_sum[i] - (neighbours.row_sum.empty() ? 0 : neighbours.row_sum[i]);
-                return sum + fluid_sum * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
-            }
             const PoreWaterLaw& l = law(p, i);
-            return m_conductance_sum[i] * l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
+            const Real dphi_dm = l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
+            if (m_flux == PairFlux::Darcy) return (neighbours.row_sum[i] + m_fluid_conductance_sum[i]) * dphi_dm;
+            // Eq. 20 diffuses m_p / V: stable for dt sum_j (d_ij / h) V_j F_ij <= 1, with
+            // d_ij <= (|v_pi| + |v_pj|) / 2; fluid pairs as for M15.
+            Real sum = 0;
+            for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s) {
+                const Index j = neighbours.other[s];
+                sum += 0.5 * (m_pore_velocity[i].norm() + m_pore_velocity[j].norm()) / m_h * p.volume[j] * neighbours.weight[s];
+            }
+            return sum + m_fluid_conductance_sum[i] * dphi_dm;
         });
         const Real limit = stiffness > 0 ? 0.5 / stiffness : remaining;
         const Real steps = std::ceil(remaining / limit - 1e-12);

@@ -42,7 +42,7 @@ struct PorePairs {
     std::vector<Index> other;
     std::vector<Real> conductance;
     std::vector<Real> weight;   ///< F_ij of M16 (calibrated), 1/m^3, for the paper's Eq. 20
-    std::vector<Real> row_sum;  ///< sum of each row's conductances (empty: summed when needed)
+    std::vector<Real> row_sum;  ///< sum of each row's conductances, kg/(s Pa)
     Index rows() const { return Index(start.size()) - 1; }
 };
 
@@ -86,14 +86,17 @@ private:
     void refresh_metric(const PorousParticles& particles, const NeighbourLists* only_with = nullptr);
     /// Per particle: S (M3), Phi (M6) and k_r; limiter scales back to 1.
     void refresh_state(const PorousParticles& particles);
-    /// rho0 V_lo V_hi (k/eta)_pair F c_eps / h^2 of M15/M16 (lo < hi), kg/(s Pa) without k_r;
-    /// 0 for impermeable particles and for fragments not in contact.
-    Real pair_conductance(const PorousParticles& particles, Index lo, Index hi) const;
+    /// rho0 V_lo V_hi (k/eta)_pair F / h^2 of M15 (lo < hi) for the pair weight F, kg/(s Pa)
+    /// without k_r.
+    Real pair_conductance(const PorousParticles& particles, Index lo, Index hi, Real weight) const;
+    /// F_lo,hi of M16 in the metric of both kernels, calibrated (1/m^3); 0 for impermeable
+    /// particles and for fragments not in contact.
+    Real pair_weight_between(const PorousParticles& particles, Index lo, Index hi) const;
     /// Conductance of porous k with a fluid particle of volume m / rho0 at offset x (M15, fluid pair).
     Real fluid_conductance(const PorousParticles& particles, Index k, const Vec3& x, Real m) const;
-    /// Each fluid pair's conductance in the slots of fluid.porous_fluid, and the sum of all a
-    /// porous particle's conductances (for the sub-step limit).
-    void cache_conductances(const PorousParticles& particles, const PorePairs& pairs, const FluidExchange* fluid);
+    /// Each fluid pair's conductance in the slots of fluid.porous_fluid, and their sum per
+    /// porous particle (for the sub-step limit).
+    void cache_fluid_conductances(const PorousParticles& particles, const FluidExchange& fluid);
     /// q_{j->i} of M15 with the pair's terms evaluated in (min, max) index order, so that the
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
     Real pair_flux(Index i, Index j, Real conductance) const;
@@ -120,7 +123,7 @@ private:
     std::vector<Real> m_fluid_donor_scale, m_fluid_receiver_scale;  ///< per fluid particle, limiter
     std::vector<Real> m_fluid_flux, m_fluid_transfer;    ///< per porous-fluid slot: kg/s, kg this step
     std::vector<Real> m_fluid_conductance;               ///< per porous-fluid slot, kg/(s Pa)
-    std::vector<Real> m_conductance_sum;                 ///< per porous particle, kg/(s Pa)
+    std::vector<Real> m_fluid_conductance_sum;           ///< per porous particle, kg/(s Pa)
 };
 
 }  // namespace karst

@@ -66,6 +66,10 @@ struct PoreWaterLaw {
     Real flow_potential(Real S, const Vec3& x) const {
         return pore_pressure(S) - capillary_potential(S) - rest_density * gravity.dot(x);
     }
+    /// M17: the pore (interstitial) velocity v_p = -(k_r K / (phi eta)) grad Phi, m/s.
+    Vec3 pore_velocity(Real kr, Real phi, const Mat3& K, const Vec3& grad_potential) const {
+        return -(kr / (phi * darcy_viscosity)) * (K * grad_potential);
+    }
     /// dPhi/dS (for the sub-step limit, §4.7.5), with dP^c/dS taken at max(1 - S, 0.01).
     Real potential_slope(Real S) const {
         const Real dry = std::max(1 - S, Real(0.01));

@@ -28,7 +28,7 @@ PointSet porous_points(const PorousParticles& p, std::span<const PoreWaterLaw> l
                 grad += p.volume[j] * (potential[j] - potential[i]) * W.gradient(p.x[i] - p.x[j]);
         });
         const Real kr = std::pow(std::min(S[i], Real(1)), law.saturation_exponent);
-        velocity[i] = -(kr / (p.porosity[i] * law.darcy_viscosity)) * (p.permeability[i] * grad);
+        velocity[i] = law.pore_velocity(kr, p.porosity[i], p.permeability[i], grad);
     });
     std::vector<std::int64_t> fragment(p.fragment.begin(), p.fragment.end());
     PointSet points;

@@ -28,10 +28,8 @@ Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbo
             // Evaluated in (min, max) order so that the pair's two forces are bitwise opposite.
             const Index lo = std::min(i, j), hi = std::max(i, j);
             const Vec3 x = p.x[lo] - p.x[hi];
-            const Real r = x.norm();
-            if (r >= law.rest_distance || r == 0) return;
-            const Vec3 n = x / r;
-            const Vec3 on_lo = (law.stiffness * (law.rest_distance - r) - law.damping * (p.v[lo] - p.v[hi]).dot(n)) * n;
+            if (const Real r = x.norm(); r >= law.rest_distance || r == 0) return;
+            const Vec3 on_lo = law.force(x, p.v[lo] - p.v[hi]);
             sum += i == lo ? on_lo : Vec3(-on_lo);
             ++touching[i];
         });
@@ -49,10 +47,8 @@ Index add_wall_contact_forces(const PorousParticles& p, const NeighbourLists& wa
         Vec3 sum = Vec3::Zero();
         walls.for_each(i, [&](Index k) {
             const Vec3 x = p.x[i] - wall_x[k];
-            const Real r = x.norm();
-            if (r >= law.rest_distance || r == 0) return;
-            const Vec3 n = x / r;
-            sum += (law.stiffness * (law.rest_distance - r) - law.damping * p.v[i].dot(n)) * n;
+            if (const Real r = x.norm(); r >= law.rest_distance || r == 0) return;
+            sum += law.force(x, p.v[i]);
             ++touching[i];
         });
         force[i] += sum;

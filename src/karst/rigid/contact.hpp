@@ -15,6 +15,13 @@ struct ContactLaw {
     /// k_c = M g / (0.01 dx) for the lightest fragment M in contact (method.md §4.2), and the
     /// damping that gives a normal restitution e for two particles of mass m_pair each.
     static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity, Real particle_mass, Real restitution = 0.2);
+    /// The spring on particle a from b at offset x = x_a - x_b with relative velocity
+    /// v = v_a - v_b (N), for 0 < |x| < d0.
+    Vec3 force(const Vec3& x, const Vec3& v) const {
+        const Real r = x.norm();
+        const Vec3 n = x / r;
+        return (stiffness * (rest_distance - r) - damping * v.dot(n)) * n;
+    }
 };
 
 /// Adds the contact forces (N) into `force` (one per particle); `neighbours` lists particles

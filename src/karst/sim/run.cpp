@@ -36,7 +36,7 @@ MassTotals mass_totals(const State& s) {
     MassTotals t;
     t.solute = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.solute[i]; });
     t.absorbed = deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
-    t.water = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.mass[i] - f.solute[i] - f.drained[i]; }) + t.absorbed;
+    t.water = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.water(i); }) + t.absorbed;
     t.grains = t.solute + deterministic_sum(p.size(), Real(0), [&](Index i) { return p.solid_mass[i]; });
     return t;
 }

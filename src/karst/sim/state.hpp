@@ -31,6 +31,8 @@ struct FluidParticles {
     std::vector<Real> p;          ///< (n) PCISPH pressure of the last step, Pa
     std::vector<std::int64_t> id; ///< (n) stable particle id (export only)
     Index size() const { return Index(x.size()); }
+    /// The water particle i holds: m - m_sol - drained, kg.
+    Real water(Index i) const { return mass[i] - solute[i] - drained[i]; }
     /// Keeps the particles whose flag is true, in order.
     void keep(const std::vector<char>& flag);
     /// Reorders every attribute by perm (new k <- old perm[k]).

@@ -2,7 +2,6 @@
 // into the profile and followed by the watchdog's check of what it wrote.
 #include "karst/sim/step.hpp"
 
-#include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/coupling/fluid_reactions.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
@@ -67,20 +66,8 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     porous.pore_substeps += report.substeps;
     porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, fluid.main_receiver,
                                                   state.scratch.fluid_fluid, model.particle_mass);
-    // Which porous particles may dissolve (porous/dissolution.hpp), while the lists hold: fluid
-    // lies within h, and none closer than 0.6 dx.
-    const std::vector<Vec3>& x = porous.particles.x;
-    const Real touch = model.h * model.h, crowd = 0.36 * model.dx * model.dx;
-    s.exposed.assign(x.size(), 0);
-    parallel_for(Index(x.size()), [&](Index k) {
-        bool wet = false, crowded = false;
-        s.porous_fluid.for_each(k, [&](Index i) {
-            if (state.fluid.mass[i] == 0) return;
-            const Real r2 = (state.fluid.x[i] - x[k]).squaredNorm();
-            wet = wet || r2 < touch, crowded = crowded || r2 < crowd;
-        });
-        s.exposed[k] = wet && !crowded;
-    });
+    // Which porous particles may dissolve later in the step, while the lists hold.
+    mark_exposed(porous.particles, state.fluid, s.porous_fluid, model.h, model.dx, s.exposed);
 }
 
 /// §3 step 9: saturated, porous-enough particles become muddy fluid; their fragments lose them.
