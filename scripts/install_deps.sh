@@ -9,6 +9,7 @@ packages=(
     libcgal-dev libgmp-dev libmpfr-dev   # Delaunay / alpha shapes (PFEM mesh)
     libtbb-dev               # the one parallel runtime
     libsuitesparse-dev libopenblas0-pthread   # CHOLMOD; OpenBLAS makes it 15x faster than reference BLAS
+    libhypre-dev             # BoomerAMG for large Biot systems (brings Open MPI)
     nlohmann-json3-dev       # scene files
     libcli11-dev             # command line
     libfmt-dev libspdlog-dev # messages

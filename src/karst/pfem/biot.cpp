@@ -14,11 +14,14 @@
 #include "karst/core/check.hpp"
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
+#include "karst/pfem/amg_solver.hpp"
 #include "karst/pfem/p1_tet.hpp"
 #include "karst/pfem/polyhedral_elements.hpp"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
+
+#include <optional>
 
 namespace karst {
 
@@ -104,6 +107,38 @@ Real relative_change(const Vector& next, const Vector& previous) {
     return norm > 0 ? change / norm : change;
 }
 
+/// A symmetric positive definite system solved by CHOLMOD (exact; one factorisation, cheap solves)
+/// or by AMG-preconditioned conjugate gradients (warm-started from the previous iterate).
+class SpdSolve {
+public:
+    /// Factorises or sets up A. The pattern analysis of CHOLMOD is kept while `same_pattern`.
+    void compute(const SparseMatrix& A, bool iterative, const AmgOptions& amg_options, bool same_pattern) {
+        m_iterative = iterative;
+        if (iterative) {
+            m_amg.reset();  // free the old hierarchy before building the next
+            m_amg.emplace(A, amg_options);
+            return;
+        }
+        if (!same_pattern || !m_analysed) m_direct.analyzePattern(A), m_analysed = true;
+        m_direct.factorize(A);
+        KARST_CHECK(m_direct.info() == Eigen::Success);
+    }
+    /// x = A^{-1} b; `guess` starts the iteration.
+    Vector solve(const Vector& b, const Vector& guess) {
+        if (!m_iterative) return m_direct.solve(b);
+        Vector x = guess;
+        iterations += m_amg->solve(b, x);
+        return x;
+    }
+    Real seconds_amg_setup() const { return m_iterative ? m_amg->seconds_setup() : 0; }
+    Index iterations = 0;  ///< CG iterations so far (iterative mode)
+
+private:
+    bool m_iterative = false, m_analysed = false;
+    Eigen::CholmodSupernodalLLT<SparseMatrix> m_direct;
+    std::optional<AmgSolver> m_amg;
+};
+
 }  // namespace
 
 struct BiotSolver::Impl {
@@ -125,12 +160,11 @@ struct BiotSolver::Impl {
     DofSplit u_dofs{{}}, p_dofs{{}};
     SparseMatrix K_ff, K_fc, H_ff, H_fc;
     Vector elastic_lift;  // K_fc u_c
-    Eigen::CholmodSupernodalLLT<SparseMatrix> elastic;
-    // Flow by CHOLMOD too, chosen by measurement (70k-node benchmark): warm-started conjugate
-    // gradients with a Jacobi preconditioner took 4.2 s for the 4 flow solves of a call against
-    // 2.2 s factorisation + 1.5 s for the whole loop, since dt H dominates the storage there.
-    Eigen::CholmodSupernodalLLT<SparseMatrix> flow;
-    bool flow_analysed = false, mobility_changed = true;
+    // Linear solvers (LinearSolver in biot.hpp for the measurements). Warm-started CG with a
+    // Jacobi preconditioner was also tried for the flow: 4.2 s for the 4 flow solves of one call.
+    SpdSolve elastic, flow;
+    bool iterative = false;
+    bool flow_ready = false, mobility_changed = true;
     Real flow_dt = -1;
     Real t_assembly = 0, t_elastic_factor = 0;
 
@@ -155,9 +189,20 @@ struct BiotSolver::Impl {
         t_assembly = watch.seconds();
         Stopwatch factor_watch;
         KARST_CHECK(u_dofs.free_count > 0);
-        elastic.compute(K_ff);
-        KARST_CHECK(elastic.info() == Eigen::Success);
+        // A free body's six near-rigid modes (eps diag K) defeat CG: it stays direct.
+        iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
+        elastic.compute(K_ff, iterative, elastic_amg_options(), false);
         t_elastic_factor = factor_watch.seconds();
+    }
+
+    /// Systems AMG over the free displacement rows: each row keeps its component.
+    AmgOptions elastic_amg_options() const {
+        AmgOptions o;
+        o.functions = 3, o.tolerance = options.amg_tolerance;
+        o.row_function.resize(size_t(u_dofs.free_count));
+        for (size_t i = 0; i < u_dofs.free_index.size(); ++i)
+            if (u_dofs.free_index[i] >= 0) o.row_function[size_t(u_dofs.free_index[i])] = int(i % 3);
+        return o;
     }
 
     /// P1 mechanics straight into compressed columns, in parallel over nodes (each node owns its
@@ -372,9 +417,10 @@ struct BiotSolver::Impl {
             const int r = p_dofs.free_index[a];
             if (r >= 0) A.coeffRef(r, r) += storage[a];
         }
-        if (!flow_analysed) flow.analyzePattern(A), flow_analysed = true;
-        flow.factorize(A);
-        KARST_CHECK(flow.info() == Eigen::Success);
+        AmgOptions o;
+        o.tolerance = options.amg_tolerance;
+        flow.compute(A, iterative, o, flow_ready);
+        flow_ready = true;
     }
 
     BiotCallReport advance(Real dt, BiotFields& fields) {
@@ -389,6 +435,7 @@ struct BiotSolver::Impl {
         report.seconds_flow_factorisation = factor_watch.seconds();
 
         Stopwatch watch;
+        const Index linear_iterations_before = elastic.iterations + flow.iterations;
         const Vector u_n = Eigen::Map<const Vector>(fields.u[0].data(), 3 * n);
         Vector p_n = Eigen::Map<const Vector>(fields.p.data(), n);
         for (Index a = 0; a < n; ++a)
@@ -404,16 +451,17 @@ struct BiotSolver::Impl {
         // With u^0 = u^n the first flow solve of a call whose loads jumped sees no volume change
         // and returns p^n, so one of the five iterations is wasted; where the loads did not
         // change, the two starts agree.
-        u_dofs.scatter_free(elastic.solve(u_dofs.gather_free(f_ext + Q * p) - elastic_lift), u);
+        u_dofs.scatter_free(elastic.solve(u_dofs.gather_free(f_ext + Q * p) - elastic_lift, u_dofs.gather_free(u)), u);
         for (int k = 0; k < options.max_iterations; ++k) {
             // 1. Flow with u frozen: (S + L M + dt H) p = (S + L M) p^n + dt b - Q^T (u^k - u^n) + L M (p^k - p^n).
             const Vector rhs_full = flow_constant - Q.transpose() * (u - u_n) + L * (mass * (p - p_n));
             Vector p_next = p;
-            if (p_dofs.free_count > 0) p_dofs.scatter_free(flow.solve(p_dofs.gather_free(rhs_full) - dt * (H_fc * p_c)), p_next);
+            if (p_dofs.free_count > 0)
+                p_dofs.scatter_free(flow.solve(p_dofs.gather_free(rhs_full) - dt * (H_fc * p_c), p_dofs.gather_free(p)), p_next);
             // 2. Mechanics with p frozen: K u = f_ext + Q p.
             const Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
             Vector u_next = u;
-            u_dofs.scatter_free(elastic.solve(rhs_u), u_next);
+            u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
             // 3. Changes relative to the change over the call [D]: M22 divides by |p^{k+1}|, but
             // when a slow consolidation adds a small increment per call that test passes after
             // one iteration, and the unconverged increments add up (Terzaghi lagged 10 %).
@@ -429,6 +477,7 @@ struct BiotSolver::Impl {
         Eigen::Map<Vector>(fields.u[0].data(), 3 * n) = u;
         Eigen::Map<Vector>(fields.p.data(), n) = p;
         report.seconds_iterations = watch.seconds();
+        report.linear_iterations = elastic.iterations + flow.iterations - linear_iterations_before;
         return report;
     }
 };

@@ -94,6 +94,7 @@ BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh
     options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
     options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
     options.polyhedral = pe.mfem_polyhedra;
+    options.linear_solver = pe.amg ? LinearSolver::Amg : LinearSolver::Direct;
     BiotSolver solver(mesh, biot_problem(model, model.scene.porous_solids[body.solid], mesh, body_tensors), options);
     timings.assembly += solver.seconds_assembly();
     timings.factorisation += solver.seconds_elastic_factorisation();
