@@ -155,6 +155,7 @@ struct BiotSolver::Impl {
     Vector lumped_volume, storage;  // per node: M_a, S_a
     Vector gravity_flux;            // b
     Vector f_ext;                   // body force + nodal loads
+    Vector f_problem;               // body force + the problem's nodal_force (f_ext without extra loads)
     Vector u_prescribed, p_prescribed;
 
     DofSplit u_dofs{{}}, p_dofs{{}};
@@ -185,6 +186,7 @@ struct BiotSolver::Impl {
             assemble_p1_mechanics();
         }
         mass_ff = p_dofs.split(mass).first;
+        f_problem = f_ext;
         assemble_flow();
         t_assembly = watch.seconds();
         Stopwatch factor_watch;
@@ -431,7 +433,9 @@ struct BiotSolver::Impl {
                            ? m.biot_coefficient * m.biot_coefficient / m.drained_bulk_modulus()
                            : 0;
         Stopwatch factor_watch;
-        if (mobility_changed || dt != flow_dt) factorise_flow(dt, L);
+        // A dt within 1e-9 of the factorised one (a coupled run's dt_B, summed from its steps)
+        // reuses the factor.
+        if (mobility_changed || std::abs(dt - flow_dt) > 1e-9 * dt) factorise_flow(dt, L);
         report.seconds_flow_factorisation = factor_watch.seconds();
 
         Stopwatch watch;
@@ -494,6 +498,11 @@ void BiotSolver::set_mobility(std::vector<Mat3> mobility) {
     KARST_CHECK(mobility.size() == size_t(m_impl->mesh.tet_count()));
     m_impl->problem.mobility = std::move(mobility);
     m_impl->assemble_flow();
+}
+
+void BiotSolver::set_extra_loads(const std::vector<Vec3>& loads) {
+    KARST_CHECK(loads.size() == size_t(m_impl->n));
+    m_impl->f_ext = m_impl->f_problem + Eigen::Map<const Vector>(loads[0].data(), 3 * m_impl->n);
 }
 
 const BiotProblem& BiotSolver::problem() const { return m_impl->problem; }

@@ -98,6 +98,10 @@ public:
     /// New per-tet mobility (M24 feedback); H is reassembled at the next call.
     void set_mobility(std::vector<Mat3> mobility);
 
+    /// Nodal loads (N, per node) added to the body force and the problem's own nodal_force from
+    /// the next call on: the fluid's forces on a coupled fragment (method.md §5.3).
+    void set_extra_loads(const std::vector<Vec3>& loads);
+
     const BiotProblem& problem() const;
     Real seconds_assembly() const;
     Real seconds_elastic_factorisation() const;

@@ -1,22 +1,12 @@
 #pragma once
 // One porous solid's structure side (method.md §5): its PFEM mesh on the rest positions, the
 // Biot problem its scene entry describes, the fields u and p, and what a frame shows of them.
-#include "karst/io/frame_writer.hpp"
-#include "karst/pfem/biot.hpp"
-#include "karst/pfem/nodal_stress.hpp"
+#include "karst/pfem/biot_setup.hpp"
 #include "karst/porous/pore_flow.hpp"
-#include "karst/sim/model.hpp"
 
 #include <memory>
 
 namespace karst {
-
-/// Seconds spent per PFEM phase, summed over solids and calls (stats.json "phases").
-struct PfemTimings {
-    Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0, pore_flow = 0;
-    Index biot_calls = 0, biot_iterations = 0;
-    bool all_converged = true;
-};
 
 class PoroelasticSolid {
 public:
@@ -46,12 +36,11 @@ public:
 
 private:
     void refresh_permeability();
-    /// M23 at node a from its volumetric strain and Biot pressure.
-    Real porosity_at(const NodalStress& stress, Index a) const;
 
     const PorousSolid& m_scene;
     bool m_feedback, m_pore_water;
     Real m_h;                   ///< SPH support radius, m
+    Real m_rest_volume;         ///< V0 of every particle, m^3
     std::vector<Mat3> m_body_tensors;  ///< K0 per node (M12), m^2
     PoreWaterLaw m_law;
     PorousParticles m_particles;
@@ -60,7 +49,7 @@ private:
     TetMesh m_mesh;
     BiotSolver m_solver;
     BiotFields m_fields;
-    std::vector<Real> m_assembled_k;  ///< per tet: the permeability H was assembled with, m^2
+    std::vector<Real> m_assembled_scale;  ///< per tet: the k/k0 H was assembled with
 };
 
 }  // namespace karst

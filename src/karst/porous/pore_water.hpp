@@ -24,6 +24,7 @@ struct PorousParticles {
     std::vector<Vec3> rest;            ///< X, position in the fragment's body frame about its centre, m
     std::vector<Index> material;       ///< index of the material's PoreWaterLaw (the scene's solid)
     std::vector<Mat3> body_permeability;  ///< K0 in the body frame (M12), m^2
+    std::vector<Index> id;             ///< stable over removals (the PFEM mesh's node -> particle map)
     Index size() const { return Index(x.size()); }
     Index material_of(Index i) const { return material.empty() ? 0 : material[i]; }
     /// Appends the particles of `other`.
@@ -32,12 +33,14 @@ struct PorousParticles {
         add(x, other.x), add(volume, other.volume), add(porosity, other.porosity), add(absorbed_mass, other.absorbed_mass);
         add(solid_mass, other.solid_mass), add(v, other.v), add(permeability, other.permeability), add(fragment, other.fragment);
         add(rest, other.rest), add(material, other.material), add(body_permeability, other.body_permeability);
+        add(id, other.id);
     }
     /// Keeps the particles whose flag is set, in order.
     void keep(const std::vector<char>& flag) {
         keep_flagged(x, flag), keep_flagged(volume, flag), keep_flagged(porosity, flag), keep_flagged(absorbed_mass, flag);
         keep_flagged(solid_mass, flag), keep_flagged(v, flag), keep_flagged(permeability, flag), keep_flagged(fragment, flag);
         keep_flagged(rest, flag), keep_flagged(material, flag), keep_flagged(body_permeability, flag);
+        keep_flagged(id, flag);
     }
 };
 

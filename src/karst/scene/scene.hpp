@@ -106,6 +106,7 @@ struct PoroelasticSettings {
     bool pressure_from_pore_water = true;  ///< seed p^n from M5 each call (else carry the Biot p)
     bool mfem_polyhedra = false;     ///< M21 shape functions instead of P1
     bool amg = false;                ///< BoomerAMG-preconditioned CG instead of CHOLMOD
+    bool coupled_fragments = true;   ///< Biot on anchored fragments in coupled scenes
     int max_iterations = 5;
     Real tolerance = 1e-3;
     bool permeability_feedback = true;  ///< §5.4 after every call

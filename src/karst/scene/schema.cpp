@@ -190,6 +190,12 @@ std::vector<KeySpec> make_schema() {
         key("/poroelastic", T::Object, "", any(), json::object(), "PFEM mesh and Biot solver (method.md §5)."),
         key("/poroelastic/time_step", T::Number, "s", positive(1e6), 1.0 / 30,
             "Biot step dt_B (one call per step; method.md §8.2: one per frame)."),
+        key("/poroelastic/coupled_fragments", T::Enum, "", any(), "anchored",
+            "In a scene with fluid or free solids: anchored: every anchored fragment of a permeable solid is "
+            "meshed and gets a Biot call every time_step, loaded by the fluid's forces, with its pore pressure "
+            "from the pore water, feeding porosity, bulk volume and permeability back (method.md §5); none: "
+            "fragments stay rigid (faster; no stress, no mesh frames). Free fragments are not solved.",
+            {"anchored", "none"}),
         key("/poroelastic/fluid_bulk_modulus", T::Number, "Pa", closed(1, 1e12), 1e5,
             "Pore-water bulk modulus K_f in the Biot storage 1/M = phi/K_f + (B - phi)/K_s. The "
             "default is the SPH pore stiffness gamma k^p (method.md §8.2); water is 2.2e9."),

@@ -5,6 +5,7 @@
 #include "karst/coupling/porous_boundary_volumes.hpp"
 #include "karst/coupling/porous_neighbours.hpp"
 #include "karst/io/frame_writer.hpp"
+#include "karst/pfem/fragment_structure.hpp"
 #include "karst/porous/porous_points.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/model.hpp"
@@ -19,6 +20,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 
 namespace karst {
 
@@ -55,15 +57,20 @@ Real step_towards(Real dt_cfl, Real now, Real target) {
     return remaining / n;
 }
 
-/// Coupled scenes run the rigid fragments only (the Biot step is not coupled yet), so Biot
-/// boundary conditions would be silently ignored: refuse them.
+/// In a coupled scene the Biot step runs on anchored fragments of permeable solids only, so
+/// constraints anywhere else would be silently ignored: refuse them.
 void check_coupled_scene(const Scene& scene) {
-    for (const PorousSolid& s : scene.porous_solids)
-        if (!s.constraints.empty())
+    for (const PorousSolid& s : scene.porous_solids) {
+        if (s.constraints.empty()) continue;
+        const char* why = !scene.poroelastic.coupled_fragments ? "/poroelastic/coupled_fragments is none"
+                          : !s.anchored                        ? "the solid is free (free fragments move rigidly)"
+                          : s.material.porosity < k_min_porosity ? "the solid is impermeable (porosity below 1e-4)"
+                                                                 : nullptr;
+        if (why)
             throw SceneError(s.path + "/constraints",
-                             "no Biot constraints in a scene with fluid or free solids (the PFEM step runs only in "
-                             "poroelastic-only scenes so far)",
+                             fmt::format("no Biot constraints here: {}, so no Biot problem is solved for this solid", why),
                              fmt::format("{} constraints", s.constraints.size()));
+    }
 }
 
 /// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current
@@ -97,6 +104,9 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     check_coupled_scene(scene);
     State state = make_initial_state(model);
     const bool porous = state.porous.size() > 0;
+    std::optional<FragmentStructures> structures;
+    if (porous && scene.poroelastic.coupled_fragments) structures.emplace(model, state.porous);
+    const bool meshes = structures && !structures->empty();
 
     RunResult result;
     result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
@@ -105,7 +115,9 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     auto write_frame = [&](const FrameLog& log) {
         PointSet porous_points;
         if (porous) porous_points = porous_frame(model, state);
-        out.write_frame({&state.fluid, nullptr, porous ? &porous_points : nullptr}, log);
+        MeshFrame mesh;
+        if (meshes) structures->append_to(mesh);
+        out.write_frame({&state.fluid, meshes ? &mesh : nullptr, porous ? &porous_points : nullptr}, log);
     };
 
     // Densities of the initial state, so frame 0 shows them.
@@ -134,10 +146,13 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         const MassTotals final_totals = mass_totals(state);
         nlohmann::json phases;
         for (size_t s = 0; s < size_t(Stage::Count); ++s) phases[std::string(k_stage_names[s])] = profile.seconds[s];
+        const PfemTimings pfem = structures ? structures->timings() : PfemTimings{};
+        phases["meshing"] = pfem.meshing, phases["assembly"] = pfem.assembly;
+        phases["factorisation"] = pfem.factorisation, phases["iterations"] = pfem.iterations;
         return nlohmann::json{
             {"scene", scene.name},
             {"counts", {{"fluid", state.fluid.size()}, {"boundary", model.walls.size()}, {"porous", state.porous.size()},
-                        {"elements", 0}, {"fragments", live_fragments(state)}, {"removed", state.removed},
+                        {"elements", structures ? structures->elements() : 0}, {"fragments", live_fragments(state)}, {"removed", state.removed},
                         {"porous_removed", state.porous.removed}, {"dissolved", state.porous.dissolved},
                         {"fluid_drained", state.porous.fluid_deleted}}},
             {"steps", state.steps},
@@ -151,6 +166,9 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                       {"solute_initial", initial.solute}, {"solute_final", final_totals.solute},
                       {"grains_initial", initial.grains}, {"grains_final", final_totals.grains}}},
             {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
+            {"biot", {{"calls", pfem.biot_calls}, {"iterations", pfem.biot_iterations}, {"remeshes", pfem.remeshes},
+                      {"mean_iterations", pfem.biot_calls ? double(pfem.biot_iterations) / pfem.biot_calls : 0.0},
+                      {"all_converged", pfem.all_converged}}},
             {"max_density_error", max_density_error},
             {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
             {"threads", ThreadLimit::active_threads()},
@@ -162,14 +180,15 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         while (state.time < end - 1e-12 * std::max(Real(1), end)) {
             const Real frame_time = std::min(end, next_frame * frame_dt);
             Real dt = cfl_time_step(model, state);
-            if (!scene.time.fixed_dt) dt = step_towards(dt, state.time, frame_time);
+            const Real target = meshes ? std::min(frame_time, state.time + structures->time_to_next_call(model)) : frame_time;
+            if (!scene.time.fixed_dt) dt = step_towards(dt, state.time, target);
             last_good = state.fluid;
             if (porous) last_good_porous = state.porous;
             const Real last_good_time = state.time;
             StepReport report;
             try {
                 Stopwatch step_watch;
-                report = step(model, state, dt, profile);
+                report = step(model, state, dt, profile, structures ? &*structures : nullptr);
                 frame_step_seconds += step_watch.seconds();
             } catch (const WatchdogError&) {
                 // Keep what was good: the state before the failing step becomes the last frame.

@@ -30,6 +30,7 @@ void make_porous(const Model& model, PorousState& porous) {
         const Index first = p.size(), fragment = Index(porous.fragments.size());
         p.append(porous_particles_at_rest(model, body, fragment));
         const Index n = p.size() - first;
+        for (Index i = first; i < p.size(); ++i) p.id[i] = i;
         std::vector<Real> mass(n);
         for (Index i = 0; i < n; ++i) mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];
         std::vector<Vec3> rest;

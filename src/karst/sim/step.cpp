@@ -6,6 +6,7 @@
 #include "karst/coupling/fluid_reactions.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
 #include "karst/coupling/porous_neighbours.hpp"
+#include "karst/pfem/fragment_structure.hpp"
 #include "karst/porous/dissolution.hpp"
 #include "karst/porous/drained_fluid.hpp"
 #include "karst/porous/pore_flow.hpp"
@@ -81,7 +82,7 @@ void dissolve_particles(const Model& model, State& state) {
 
 }  // namespace
 
-StepReport step(const Model& model, State& state, Real dt, StepProfile& profile) {
+StepReport step(const Model& model, State& state, Real dt, StepProfile& profile, FragmentStructures* structures) {
     const Real t = state.time;
     const auto& id = state.fluid.id;
     const bool porous = state.porous.size() > 0;
@@ -113,7 +114,11 @@ StepReport step(const Model& model, State& state, Real dt, StepProfile& profile)
 
     if (porous) {
         // 4b. The fluid's last pressure, friction and adhesion act back on the porous particles.
-        timed(profile, Stage::FluidReactions, [&] { compute_fluid_reactions(model, state); });
+        timed(profile, Stage::FluidReactions, [&] {
+            compute_fluid_reactions(model, state);
+            // They are the nodal loads of the next Biot call (§4.3, §5.3), summed over its interval.
+            if (structures && !structures->empty()) structures->add_loads(state.porous.particles, state.porous_scratch.force, dt);
+        });
         // 5. Pore flow, absorption and drained fluid (§4.7), before anything moves.
         timed(profile, Stage::PoreFlow, [&] { pore_flow_and_absorption(model, state, dt); });
         check_scalars(state.porous.particles.absorbed_mass, {}, Stage::PoreFlow, t, "absorbed mass");
@@ -133,6 +138,12 @@ StepReport step(const Model& model, State& state, Real dt, StepProfile& profile)
             dissolve_particles(model, state);
             refresh_fragment_mass(state, model.dx);
         });
+        // 9. Algorithm 2 on the anchored fragments every dt_B (§5): the Biot call takes the mean
+        //    fluid loads since the last one, and its porosity and permeability feed the pores.
+        if (structures && !structures->empty())
+            timed(profile, Stage::Structure, [&] {
+                if (structures->advance(model, state.porous)) state.porous_scratch.pairs_stale = true;
+            });
     }
 
     state.time = t + dt;

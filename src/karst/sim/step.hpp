@@ -11,8 +11,11 @@ struct StepReport {
     Real max_density_error = 0;  ///< fraction of rho0
 };
 
-/// Advances the state by one step of length dt (method.md §3; this stages 1-5).
-/// Throws WatchdogError if a stage produces a NaN or a runaway speed.
-StepReport step(const Model& model, State& state, Real dt, StepProfile& profile);
+class FragmentStructures;
+
+/// Advances the state by one step of length dt (method.md §3). `structures`, when given, runs
+/// the Biot step of the anchored fragments (§5). Throws WatchdogError if a stage produces a NaN
+/// or a runaway speed.
+StepReport step(const Model& model, State& state, Real dt, StepProfile& profile, FragmentStructures* structures = nullptr);
 
 }  // namespace karst

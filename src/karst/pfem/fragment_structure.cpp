@@ -1,0 +1,154 @@
+#include "karst/pfem/fragment_structure.hpp"
+
+#include "karst/core/parallel.hpp"
+
+#include <optional>
+
+namespace karst {
+
+namespace {
+
+/// A fragment is remeshed once it has lost this fraction of its nodes (to dissolution or the
+/// domain) [D]: the sheet remeshes at every topology event (§4.10), but an eroding rock loses a
+/// few grains at most steps, and each remesh refactorises the elasticity. Until then the lost
+/// nodes keep their stiffness and take no load.
+constexpr Real k_remesh_lost_fraction = 0.01;
+
+}  // namespace
+
+struct FragmentStructures::Structure {
+    Index fragment = 0;
+    const PorousSolid* solid = nullptr;
+    std::vector<Index> node_id;  ///< particle id of each node
+    TetMesh mesh;
+    std::optional<BiotSolver> solver;
+    BiotFields fields;
+    std::vector<Mat3> node_tensors;     ///< K0 per node
+    std::vector<Real> assembled_scale;  ///< per tet, for refresh_mobility
+};
+
+FragmentStructures::FragmentStructures(const Model& model, const PorousState& porous) {
+    const PorousParticles& p = porous.particles;
+    Index ids = 0;
+    for (Index i = 0; i < p.size(); ++i) ids = std::max(ids, p.id[i] + 1);
+    m_impulse.assign(ids, Vec3::Zero()), m_u.assign(ids, Vec3::Zero()), m_rest_tensor.assign(ids, Mat3::Zero());
+    m_paired_scale.assign(ids, 1), m_paired_volume.assign(ids, 0);
+    for (Index i = 0; i < p.size(); ++i) m_rest_tensor[p.id[i]] = p.body_permeability[i], m_paired_volume[p.id[i]] = p.volume[i];
+    for (size_t f = 0; f < porous.fragments.size(); ++f) {
+        if (!porous.fragments[f].anchored || porous.fragments[f].mass <= 0) continue;
+        // The fragment's solid: its members share one material.
+        Index material = -1;
+        for (Index i = 0; i < p.size() && material < 0; ++i)
+            if (p.fragment[i] == Index(f)) material = p.material[i];
+        const PorousSolid& solid = model.scene.porous_solids[material];
+        if (solid.material.porosity < k_min_porosity) continue;  // impermeable: no pore pressure, a rigid boundary
+        auto s = std::make_unique<Structure>();
+        s->fragment = Index(f), s->solid = &solid;
+        build(model, porous, *s);
+        m_structures.push_back(std::move(s));
+    }
+}
+
+FragmentStructures::~FragmentStructures() = default;
+
+void FragmentStructures::build(const Model& model, const PorousState& porous, Structure& s) {
+    // An anchored fragment never moves or turns, so its rest frame is the world frame: the mesh
+    // lives at the particles' world positions, where the scene's regions and walls are.
+    const PorousParticles& p = porous.particles;
+    std::vector<Vec3> x;
+    s.node_id.clear();
+    for (Index i = 0; i < p.size(); ++i)
+        if (p.fragment[i] == s.fragment) x.push_back(p.x[i]), s.node_id.push_back(p.id[i]);
+    s.solver.reset();  // it refers to the old mesh
+    s.mesh = mesh_points(model, x, m_timings);
+    s.node_tensors.resize(x.size());
+    s.fields.u.resize(x.size()), s.fields.p.assign(x.size(), 0);
+    for (size_t a = 0; a < x.size(); ++a) s.node_tensors[a] = m_rest_tensor[s.node_id[a]], s.fields.u[a] = m_u[s.node_id[a]];
+    // [D] Geostatic start: a coupled fragment's rest state is its state at rest under its own
+    // weight, so gravity (body force and gravity flux) leaves the problem and u, eps_v and p are
+    // the response to the fluid's loads and to the pore overpressure P^p (M5, zero up to S = 1).
+    // With gravity in, a resting block of E = 1 MPa soil consolidated under its own weight at
+    // t = 0, and its porosity fell and its pore pressure rose before any water arrived. Biot is
+    // linear, so dropping a constant load only shifts the reference state.
+    BiotProblem problem = biot_problem(model, *s.solid, s.mesh, s.node_tensors);
+    problem.gravity = Vec3::Zero();
+    s.solver.emplace(make_biot_solver(model, s.mesh, std::move(problem), m_timings));
+    s.assembled_scale.assign(s.mesh.tet_count(), 1);
+}
+
+void FragmentStructures::add_loads(const PorousParticles& particles, const std::vector<Vec3>& force, Real dt) {
+    parallel_for(particles.size(), [&](Index i) { m_impulse[particles.id[i]] += dt * force[i]; });
+    m_elapsed += dt;
+}
+
+bool FragmentStructures::advance(const Model& model, PorousState& porous) {
+    const Real dt = m_elapsed;
+    if (m_structures.empty() || dt < model.scene.poroelastic.time_step * (1 - 1e-9)) return false;
+    PorousParticles& p = porous.particles;
+    std::vector<Index> index_of(m_impulse.size(), -1);
+    for (Index i = 0; i < p.size(); ++i) index_of[p.id[i]] = i;
+    const bool feedback = model.scene.poroelastic.permeability_feedback;
+    const Real rest_volume = model.dx * model.dx * model.dx;
+    bool stale = false;
+    for (auto& owned : m_structures) {
+        Structure& s = *owned;
+        const Index n = s.mesh.node_count();
+        Index lost = 0;
+        for (Index a = 0; a < n; ++a) lost += index_of[s.node_id[a]] < 0;
+        if (lost > k_remesh_lost_fraction * n) {
+            for (Index a = 0; a < n; ++a) m_u[s.node_id[a]] = s.fields.u[a];
+            build(model, porous, s);
+            ++m_timings.remeshes;
+        }
+        // Loads: the mean force since the last call (§5.3); p^n <- P^p (M5) from the pore water.
+        const PoreWaterLaw& law = model.pore_laws[s.solid - model.scene.porous_solids.data()];
+        std::vector<Vec3> loads(s.mesh.node_count(), Vec3::Zero());
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            const Index i = index_of[s.node_id[a]];
+            if (i < 0) continue;
+            loads[a] = m_impulse[s.node_id[a]] / dt;
+            s.fields.p[a] = law.pore_pressure(law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
+        }
+        s.solver->set_extra_loads(loads);
+        const BiotCallReport r = s.solver->advance(dt, s.fields);
+        m_timings.factorisation += r.seconds_flow_factorisation, m_timings.iterations += r.seconds_iterations;
+        ++m_timings.biot_calls, m_timings.biot_iterations += r.iterations;
+        m_timings.all_converged = m_timings.all_converged && r.converged;
+        if (!feedback) continue;
+        // Feedback (§5.4): porosity, bulk volume V = V0 (1 + eps_v) and K = (k/k0) R K0 R^T.
+        const NodalStress stress = nodal_stress(s.mesh, s.solver->problem().material, s.fields);
+        const NodalPoreState pore = nodal_pore_state(s.solid->material, s.solver->problem().material, stress, s.fields.p);
+        const Mat3 R = porous.fragments[s.fragment].rotation_matrix();
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            const Index i = index_of[s.node_id[a]];
+            if (i < 0) continue;
+            p.porosity[i] = pore.porosity[a];
+            p.volume[i] = rest_volume * (1 + stress.volumetric_strain[a]);
+            p.body_permeability[i] = pore.permeability_scale[a] * s.node_tensors[a];
+            p.permeability[i] = R * p.body_permeability[i] * R.transpose();
+            const Index id = s.node_id[a];
+            stale = stale || std::abs(pore.permeability_scale[a] / m_paired_scale[id] - 1) > 0.01 ||
+                    std::abs(p.volume[i] / m_paired_volume[id] - 1) > 0.01;
+        }
+        refresh_mobility(*s.solver, s.mesh, s.solid->material, s.node_tensors, pore.permeability_scale, s.assembled_scale);
+    }
+    std::fill(m_impulse.begin(), m_impulse.end(), Vec3::Zero());
+    m_elapsed = 0;
+    if (stale)
+        for (Index i = 0; i < p.size(); ++i)
+            m_paired_scale[p.id[i]] = p.body_permeability[i].trace() / m_rest_tensor[p.id[i]].trace(), m_paired_volume[p.id[i]] = p.volume[i];
+    return stale;
+}
+
+void FragmentStructures::append_to(MeshFrame& frame) const {
+    for (const auto& s : m_structures)
+        append_mesh_frame(frame, s->mesh, s->solver->problem(), s->fields, s->solid->material, s->node_tensors);
+}
+
+Index FragmentStructures::elements() const {
+    Index n = 0;
+    for (const auto& s : m_structures) n += s->mesh.tet_count();
+    return n;
+}
+
+}  // namespace karst
