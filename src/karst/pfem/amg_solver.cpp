@@ -62,7 +62,7 @@ struct AmgSolver::Impl {
     HYPRE_IJVector ij_b = nullptr, ij_x = nullptr, ij_r = nullptr;
     HYPRE_ParVector b = nullptr, x = nullptr, r = nullptr;
     HYPRE_Solver amg = nullptr, pcg = nullptr;
-    std::vector<HYPRE_Int> row_function;  // owned here: hypre keeps the pointer
+    std::vector<HYPRE_Int> rows;  // 0 .. n-1, for setting and getting whole vectors
     Real t_setup = 0;
 
     Impl(const Eigen::SparseMatrix<Real, Eigen::ColMajor, int>& A, AmgOptions o) : n(int(A.rows())), options(std::move(o)) {
@@ -72,7 +72,8 @@ struct AmgSolver::Impl {
         // A is symmetric, so its compressed columns are the compressed rows hypre takes.
         check(HYPRE_IJMatrixCreate(comm, 0, n - 1, 0, n - 1, &ij_matrix), "matrix create");
         check(HYPRE_IJMatrixSetObjectType(ij_matrix, HYPRE_PARCSR), "matrix type");
-        std::vector<HYPRE_Int> sizes(n), rows(n);
+        std::vector<HYPRE_Int> sizes(n);
+        rows.resize(n);
         for (int r = 0; r < n; ++r) sizes[r] = A.outerIndexPtr()[r + 1] - A.outerIndexPtr()[r], rows[r] = r;
         check(HYPRE_IJMatrixSetRowSizes(ij_matrix, sizes.data()), "row sizes");
         check(HYPRE_IJMatrixInitialize(ij_matrix), "matrix initialise");
@@ -131,8 +132,6 @@ struct AmgSolver::Impl {
     }
 
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-        std::vector<HYPRE_Int> rows(n);
-        for (int r = 0; r < n; ++r) rows[r] = r;
         HYPRE_IJVectorSetValues(ij_b, n, rows.data(), rhs.data());
         HYPRE_IJVectorSetValues(ij_x, n, rows.data(), solution.data());
         // The stopping test is relative to the residual of the warm start, b - A x0: a later

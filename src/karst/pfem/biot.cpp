@@ -111,15 +111,16 @@ Real relative_change(const Vector& next, const Vector& previous) {
 /// or by AMG-preconditioned conjugate gradients (warm-started from the previous iterate).
 class SpdSolve {
 public:
-    /// Factorises or sets up A. The pattern analysis of CHOLMOD is kept while `same_pattern`.
-    void compute(const SparseMatrix& A, bool iterative, const AmgOptions& amg_options, bool same_pattern) {
+    /// Factorises or sets up A. CHOLMOD's pattern analysis is done once: every A given to one
+    /// SpdSolve has the same pattern (the mesh's).
+    void compute(const SparseMatrix& A, bool iterative, const AmgOptions& amg_options) {
         m_iterative = iterative;
         if (iterative) {
             m_amg.reset();  // free the old hierarchy before building the next
             m_amg.emplace(A, amg_options);
             return;
         }
-        if (!same_pattern || !m_analysed) m_direct.analyzePattern(A), m_analysed = true;
+        if (!m_analysed) m_direct.analyzePattern(A), m_analysed = true;
         m_direct.factorize(A);
         KARST_CHECK(m_direct.info() == Eigen::Success);
     }
@@ -130,7 +131,6 @@ public:
         iterations += m_amg->solve(b, x);
         return x;
     }
-    Real seconds_amg_setup() const { return m_iterative ? m_amg->seconds_setup() : 0; }
     Index iterations = 0;  ///< CG iterations so far (iterative mode)
 
 private:
@@ -165,7 +165,7 @@ struct BiotSolver::Impl {
     // Jacobi preconditioner was also tried for the flow: 4.2 s for the 4 flow solves of one call.
     SpdSolve elastic, flow;
     bool iterative = false;
-    bool flow_ready = false, mobility_changed = true;
+    bool mobility_changed = true;
     Real flow_dt = -1;
     Real t_assembly = 0, t_elastic_factor = 0;
 
@@ -193,7 +193,7 @@ struct BiotSolver::Impl {
         KARST_CHECK(u_dofs.free_count > 0);
         // A free body's six near-rigid modes (eps diag K) defeat CG: it stays direct.
         iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
-        elastic.compute(K_ff, iterative, elastic_amg_options(), false);
+        elastic.compute(K_ff, iterative, elastic_amg_options());
         t_elastic_factor = factor_watch.seconds();
     }
 
@@ -421,8 +421,7 @@ struct BiotSolver::Impl {
         }
         AmgOptions o;
         o.tolerance = options.amg_tolerance;
-        flow.compute(A, iterative, o, flow_ready);
-        flow_ready = true;
+        flow.compute(A, iterative, o);
     }
 
     BiotCallReport advance(Real dt, BiotFields& fields) {

@@ -9,6 +9,17 @@ namespace karst {
 
 namespace {
 
+/// The scene's /poroelastic solver settings.
+BiotOptions biot_options(const Model& model) {
+    const PoroelasticSettings& pe = model.scene.poroelastic;
+    BiotOptions options;
+    options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
+    options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
+    options.polyhedral = pe.mfem_polyhedra;
+    options.linear_solver = pe.amg ? LinearSolver::Amg : LinearSolver::Direct;
+    return options;
+}
+
 /// Mean of a tet's nodal tensors.
 Mat3 tet_mean(const Tet& t, const std::vector<Mat3>& nodal) { return 0.25 * (nodal[t[0]] + nodal[t[1]] + nodal[t[2]] + nodal[t[3]]); }
 
@@ -71,16 +82,6 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
         }
     p.free_body = std::all_of(p.fixed.begin(), p.fixed.end(), [](std::uint8_t f) { return f == 0; });
     return p;
-}
-
-BiotOptions biot_options(const Model& model) {
-    const PoroelasticSettings& pe = model.scene.poroelastic;
-    BiotOptions options;
-    options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
-    options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
-    options.polyhedral = pe.mfem_polyhedra;
-    options.linear_solver = pe.amg ? LinearSolver::Amg : LinearSolver::Direct;
-    return options;
 }
 
 BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem, PfemTimings& timings) {

@@ -29,10 +29,8 @@ BiotMaterial biot_material(const Model& model, const PorousMaterial& material);
 /// node lies within a spacing of a static wall.
 BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh, const std::vector<Mat3>& node_tensors);
 
-/// The scene's /poroelastic solver settings.
-BiotOptions biot_options(const Model& model);
-
-/// Builds the solver and adds its assembly and factorisation times.
+/// Builds the solver with the scene's /poroelastic settings and adds its assembly and
+/// factorisation times.
 BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem, PfemTimings& timings);
 
 /// Porosity (M23) and permeability scale k/k0 (M24) at every node, from the nodal strain and

@@ -9,17 +9,6 @@
 
 namespace karst {
 
-namespace {
-
-TetMesh mesh_body(const Model& model, const PorousBody& body, PfemTimings& timings) { return mesh_points(model, body.rest_x, timings); }
-
-BiotSolver make_solver(const Model& model, const PorousBody& body, const TetMesh& mesh, const std::vector<Mat3>& body_tensors,
-                       PfemTimings& timings) {
-    return make_biot_solver(model, mesh, biot_problem(model, model.scene.porous_solids[body.solid], mesh, body_tensors), timings);
-}
-
-}  // namespace
-
 PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, PfemTimings& timings)
     : m_scene(model.scene.porous_solids[body.solid]),
       m_feedback(model.scene.poroelastic.permeability_feedback),
@@ -28,8 +17,8 @@ PoroelasticSolid::PoroelasticSolid(const Model& model, const PorousBody& body, P
       m_rest_volume(model.dx * model.dx * model.dx),
       m_body_tensors(body.body_permeability),
       m_law(pore_water_law(m_scene.material, model.rho0, model.scene.gravity)),
-      m_mesh(mesh_body(model, body, timings)),
-      m_solver(make_solver(model, body, m_mesh, m_body_tensors, timings)),
+      m_mesh(mesh_points(model, body.rest_x, timings)),
+      m_solver(make_biot_solver(model, m_mesh, biot_problem(model, m_scene, m_mesh, m_body_tensors), timings)),
       m_fields{std::vector<Vec3>(m_mesh.node_count(), Vec3::Zero()), std::vector<Real>(m_mesh.node_count(), 0)} {
     for (Index a = 0; a < m_mesh.node_count(); ++a)
         if (m_solver.problem().drained[a]) m_fields.p[a] = m_solver.problem().drained_pressure[a];

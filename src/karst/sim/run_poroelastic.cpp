@@ -13,6 +13,11 @@
 
 namespace karst {
 
+nlohmann::json biot_stats(const PfemTimings& t) {
+    return {{"calls", t.biot_calls}, {"iterations", t.biot_iterations}, {"remeshes", t.remeshes},
+            {"mean_iterations", t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0}, {"all_converged", t.all_converged}};
+}
+
 RunResult run_poroelastic(const Model& model, const RunOptions& options) {
     for (const PorousSolid& solid : model.scene.porous_solids)
         if (solid.material.porosity < k_min_porosity)
@@ -91,9 +96,7 @@ RunResult run_poroelastic(const Model& model, const RunOptions& options) {
         {"phases", {{"meshing", timings.meshing}, {"assembly", timings.assembly},
                     {"factorisation", timings.factorisation}, {"iterations", timings.iterations},
                     {"pore_flow", timings.pore_flow}}},
-        {"biot", {{"calls", timings.biot_calls}, {"iterations", timings.biot_iterations},
-                  {"mean_iterations", timings.biot_calls ? double(timings.biot_iterations) / timings.biot_calls : 0.0},
-                  {"all_converged", timings.all_converged}}},
+        {"biot", biot_stats(timings)},
         {"mesh", {{"kept", quality.kept}, {"polyhedra", quality.polyhedra}, {"slivers_dropped", quality.slivers_dropped},
                   {"interior_slivers", quality.interior_slivers}}},
         {"mass", {{"water_initial", absorbed_initial}, {"water_final", absorbed()}, {"absorbed_initial", absorbed_initial},

@@ -6,6 +6,11 @@
 
 namespace karst {
 
+struct PfemTimings;
+
 RunResult run_poroelastic(const Model& model, const RunOptions& options);
+
+/// stats.json's "biot" object: calls, iterations, remeshes, mean iterations, all converged.
+nlohmann::json biot_stats(const PfemTimings& timings);
 
 }  // namespace karst
