@@ -186,31 +186,75 @@ TEST(Biot, TerzaghiConsolidationMatchesTheSeriesSolution) {
     EXPECT_LT(worst_final_change, 0.01);
 }
 
-TEST(Biot, AmgSolverMatchesTheDirectSolverOnTerzaghi) {
+TEST(Biot, SteadyLoadsReuseTheLastMechanicsSolveAsThePredictor) {
+    // Under Terzaghi's constant load, a call starts where the previous one's last mechanics solve
+    // ended: it skips the predictor solve and ends where a fresh solver (which does solve the
+    // predictor) ends from the same fields.
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(1, 1, Terzaghi::h), 0.25);
+    const BiotProblem problem = terzaghi_problem(mesh, 1);
+    BiotSolver solver(mesh, problem);
+    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
+    const BiotCallReport first = solver.advance(0.005, fields);
+    EXPECT_EQ(first.elastic_solves, first.iterations + 1);
+    BiotFields fresh_fields = fields;
+    const BiotCallReport second = solver.advance(0.005, fields);
+    const BiotCallReport fresh = BiotSolver(mesh, problem).advance(0.005, fresh_fields);
+    EXPECT_EQ(second.elastic_solves, second.iterations);
+    EXPECT_EQ(fresh.elastic_solves, fresh.iterations + 1);
+    EXPECT_EQ(second.iterations, fresh.iterations);
+    Real p_err = 0, p_ref = 0, u_err = 0, u_ref = 0;
+    for (Index a = 0; a < mesh.node_count(); ++a) {
+        p_err = std::max(p_err, std::abs(fields.p[a] - fresh_fields.p[a])), p_ref = std::max(p_ref, std::abs(fresh_fields.p[a]));
+        u_err = std::max(u_err, (fields.u[a] - fresh_fields.u[a]).norm()), u_ref = std::max(u_ref, fresh_fields.u[a].norm());
+    }
+    EXPECT_GT(p_ref, 0);
+    EXPECT_LT(p_err, 1e-10 * p_ref);
+    EXPECT_LT(u_err, 1e-10 * u_ref);
+}
+
+TEST(Biot, AmgSolversMatchTheDirectSolverOnTerzaghi) {
     // The rollers fix single components, so the systems AMG sees nodes with 1-3 free rows.
     const Real width = 1;
     const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(width, width, Terzaghi::h), 0.25);
     const BiotProblem problem = terzaghi_problem(mesh, width);
-    BiotOptions amg;
-    amg.linear_solver = LinearSolver::Amg;
-    BiotSolver direct_solver(mesh, problem), amg_solver(mesh, problem, amg);
-    BiotFields direct{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)}, iterative = direct;
-    Index cg_iterations = 0;
-    for (int call = 0; call < 4; ++call) {
-        const BiotCallReport d = direct_solver.advance(0.005, direct);
-        const BiotCallReport a = amg_solver.advance(0.005, iterative);
-        EXPECT_EQ(a.iterations, d.iterations) << "call " << call;
-        EXPECT_EQ(d.linear_iterations, 0);
-        cg_iterations += a.linear_iterations;
+    BiotOptions direct_options, amg_options, auto_options;
+    direct_options.linear_solver = LinearSolver::Direct;
+    amg_options.linear_solver = LinearSolver::Amg;
+    auto_options.amg_flow_unknowns = 0;  // this small mesh's flow goes to AMG as a large one's would
+    for (const BiotOptions& options : {amg_options, auto_options}) {
+        BiotSolver direct_solver(mesh, problem, direct_options), amg_solver(mesh, problem, options);
+        ASSERT_FALSE(direct_solver.elastic_by_amg() || direct_solver.flow_by_amg());
+        ASSERT_TRUE(amg_solver.flow_by_amg());
+        ASSERT_EQ(amg_solver.elastic_by_amg(), options.linear_solver == LinearSolver::Amg);
+        BiotFields direct{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)}, iterative = direct;
+        Index cg_iterations = 0;
+        for (int call = 0; call < 4; ++call) {
+            const BiotCallReport d = direct_solver.advance(0.005, direct);
+            const BiotCallReport a = amg_solver.advance(0.005, iterative);
+            EXPECT_EQ(a.iterations, d.iterations) << "call " << call;
+            EXPECT_EQ(d.linear_iterations, 0);
+            cg_iterations += a.linear_iterations;
+        }
+        EXPECT_GT(cg_iterations, 0);
+        Real p_err = 0, p_ref = 0, u_err = 0, u_ref = 0;
+        for (Index a = 0; a < mesh.node_count(); ++a) {
+            p_err = std::max(p_err, std::abs(iterative.p[a] - direct.p[a])), p_ref = std::max(p_ref, std::abs(direct.p[a]));
+            u_err = std::max(u_err, (iterative.u[a] - direct.u[a]).norm()), u_ref = std::max(u_ref, direct.u[a].norm());
+        }
+        EXPECT_LT(p_err, 1e-6 * p_ref);
+        EXPECT_LT(u_err, 1e-6 * u_ref);
     }
-    EXPECT_GT(cg_iterations, 0);
-    Real p_err = 0, p_ref = 0, u_err = 0, u_ref = 0;
-    for (Index a = 0; a < mesh.node_count(); ++a) {
-        p_err = std::max(p_err, std::abs(iterative.p[a] - direct.p[a])), p_ref = std::max(p_ref, std::abs(direct.p[a]));
-        u_err = std::max(u_err, (iterative.u[a] - direct.u[a]).norm()), u_ref = std::max(u_ref, direct.u[a].norm());
-    }
-    EXPECT_LT(p_err, 1e-6 * p_ref);
-    EXPECT_LT(u_err, 1e-6 * u_ref);
+}
+
+TEST(Biot, AutomaticSolverChoiceFollowsThePressureUnknowns) {
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(1, 1, Terzaghi::h), 0.25);
+    const BiotProblem problem = terzaghi_problem(mesh, 1);
+    BiotOptions small, large;
+    large.amg_flow_unknowns = mesh.node_count() / 2;
+    small.amg_flow_unknowns = mesh.node_count() * 2;
+    EXPECT_FALSE(BiotSolver(mesh, problem, small).flow_by_amg());
+    EXPECT_TRUE(BiotSolver(mesh, problem, large).flow_by_amg());
+    EXPECT_FALSE(BiotSolver(mesh, problem, large).elastic_by_amg());
 }
 
 /// A confined column, nearly undrained (low mobility) with a stiff fluid: tau = B^2 M / K_dr = 1.5.

@@ -161,10 +161,11 @@ struct BiotSolver::Impl {
     DofSplit u_dofs{{}}, p_dofs{{}};
     SparseMatrix K_ff, K_fc, H_ff, H_fc;
     Vector elastic_lift;  // K_fc u_c
+    Vector last_elastic_rhs, last_elastic_u;  // the last mechanics solve: its right side and full u
     // Linear solvers (LinearSolver in biot.hpp for the measurements). Warm-started CG with a
     // Jacobi preconditioner was also tried for the flow: 4.2 s for the 4 flow solves of one call.
     SpdSolve elastic, flow;
-    bool iterative = false;
+    bool elastic_iterative = false, flow_iterative = false;
     bool mobility_changed = true;
     Real flow_dt = -1;
     Real t_assembly = 0, t_elastic_factor = 0;
@@ -192,8 +193,10 @@ struct BiotSolver::Impl {
         Stopwatch factor_watch;
         KARST_CHECK(u_dofs.free_count > 0);
         // A free body's six near-rigid modes (eps diag K) defeat CG: it stays direct.
-        iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
-        elastic.compute(K_ff, iterative, elastic_amg_options());
+        elastic_iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
+        flow_iterative = options.linear_solver == LinearSolver::Amg ||
+                         (options.linear_solver == LinearSolver::Auto && p_dofs.free_count >= options.amg_flow_unknowns);
+        elastic.compute(K_ff, elastic_iterative, elastic_amg_options());
         t_elastic_factor = factor_watch.seconds();
     }
 
@@ -421,7 +424,7 @@ struct BiotSolver::Impl {
         }
         AmgOptions o;
         o.tolerance = options.amg_tolerance;
-        flow.compute(A, iterative, o);
+        flow.compute(A, flow_iterative, o);
     }
 
     BiotCallReport advance(Real dt, BiotFields& fields) {
@@ -454,7 +457,12 @@ struct BiotSolver::Impl {
         // With u^0 = u^n the first flow solve of a call whose loads jumped sees no volume change
         // and returns p^n, so one of the five iterations is wasted; where the loads did not
         // change, the two starts agree.
-        u_dofs.scatter_free(elastic.solve(u_dofs.gather_free(f_ext + Q * p) - elastic_lift, u_dofs.gather_free(u)), u);
+        // A call whose loads and p^n are those of the previous call's last mechanics solve, from
+        // the u that solve returned (a poroelastic-only run under steady loads), has that u as its
+        // predictor: the solve is skipped.
+        const Vector rhs_predictor = u_dofs.gather_free(f_ext + Q * p) - elastic_lift;
+        const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() && rhs_predictor == last_elastic_rhs && u == last_elastic_u;
+        if (!as_last_solve) u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u), ++report.elastic_solves;
         for (int k = 0; k < options.max_iterations; ++k) {
             // 1. Flow with u frozen: (S + L M + dt H) p = (S + L M) p^n + dt b - Q^T (u^k - u^n) + L M (p^k - p^n).
             const Vector rhs_full = flow_constant - Q.transpose() * (u - u_n) + L * (mass * (p - p_n));
@@ -465,6 +473,8 @@ struct BiotSolver::Impl {
             const Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
             Vector u_next = u;
             u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
+            last_elastic_rhs = rhs_u, last_elastic_u = u_next;
+            ++report.elastic_solves;
             // 3. Changes relative to the change over the call [D]: M22 divides by |p^{k+1}|, but
             // when a slow consolidation adds a small increment per call that test passes after
             // one iteration, and the unconverged increments add up (Terzaghi lagged 10 %).
@@ -508,5 +518,7 @@ const BiotProblem& BiotSolver::problem() const { return m_impl->problem; }
 Real BiotSolver::seconds_assembly() const { return m_impl->t_assembly; }
 Real BiotSolver::seconds_elastic_factorisation() const { return m_impl->t_elastic_factor; }
 Index BiotSolver::displacement_unknowns() const { return m_impl->u_dofs.free_count; }
+bool BiotSolver::elastic_by_amg() const { return m_impl->elastic_iterative; }
+bool BiotSolver::flow_by_amg() const { return m_impl->flow_iterative; }
 
 }  // namespace karst

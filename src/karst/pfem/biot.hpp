@@ -51,12 +51,17 @@ struct BiotProblem {
 enum class Splitting { FixedStress, FixedStrain };
 
 /// How the elasticity and flow systems are solved. Measured on the 70,602-node benchmark
-/// (bench_pfem, 206,763 displacement unknowns, 2 cores): CHOLMOD factorises the elasticity in
-/// 17 s and then solves in 0.3 s; BoomerAMG sets up in 1.3 s but each warm-started CG solve
-/// takes 24-30 iterations of 0.1 s (hypre runs serially here, bound by memory bandwidth), so a
-/// call costs 13-17 s against CHOLMOD's 2.3-2.5 s. Direct is the default: a mesh lives for many calls.
-/// Amg suits a mesh rebuilt at nearly every call, or one too big for the factor's memory.
-enum class LinearSolver { Direct, Amg };
+/// (bench_pfem, 206,763 displacement and 68,921 pressure unknowns, 2 cores):
+///  - elasticity: CHOLMOD factorises in 16-18 s (7.6e11 flops) and then solves in 0.3 s;
+///    BoomerAMG sets up in 1.3 s but each warm-started CG solve takes 24-30 iterations of 0.1 s
+///    (hypre runs serially here, bound by memory bandwidth), so a call costs 13-17 s.
+///  - flow: CHOLMOD refactorises in 1.2 s (after a 1 s pattern analysis per mesh), BoomerAMG
+///    sets up in 0.1 s and solves in 14 iterations; the flow matrix changes with dt and with the
+///    mobility (every call under permeability feedback), so AMG wins on big meshes.
+/// Auto (the default) factorises the elasticity and picks the flow solver by size
+/// (BiotOptions::amg_flow_unknowns). Amg suits a mesh rebuilt at nearly every call, or one too big for the
+/// elastic factor's memory (1.8 GB at 70,000 nodes).
+enum class LinearSolver { Auto, Direct, Amg };
 
 struct BiotOptions {
     Splitting splitting = Splitting::FixedStress;
@@ -64,8 +69,11 @@ struct BiotOptions {
     Real tolerance = 1e-3;    ///< M22 stopping test on relative changes of p and u
     /// M21: EDT polyhedra with Laplace shape functions instead of P1 tets (method.md §5.2).
     bool polyhedral = false;
-    LinearSolver linear_solver = LinearSolver::Direct;
+    LinearSolver linear_solver = LinearSolver::Auto;
     Real amg_tolerance = 1e-8;  ///< CG residual, relative to that of its warm start
+    /// Auto: the flow goes to AMG from this many free pressure unknowns (the measured crossover
+    /// of a call that refactorises the flow, bench_pfem --edge).
+    Index amg_flow_unknowns = 30000;
 };
 
 struct BiotFields {
@@ -79,6 +87,7 @@ struct BiotCallReport {
     std::vector<Real> p_change, u_change;  ///< relative change at each iteration
     Real seconds_flow_factorisation = 0, seconds_iterations = 0;
     Index linear_iterations = 0;  ///< CG iterations of the elastic and flow solves (AMG only)
+    int elastic_solves = 0;       ///< predictor (when needed) and one per iteration
 };
 
 /// Owns the assembled, Dirichlet-reduced matrices and their factorisations (CHOLMOD). The
@@ -106,6 +115,9 @@ public:
     Real seconds_assembly() const;
     Real seconds_elastic_factorisation() const;
     Index displacement_unknowns() const;
+    /// The solver each system got (LinearSolver): true where BoomerAMG-CG, false where CHOLMOD.
+    bool elastic_by_amg() const;
+    bool flow_by_amg() const;
 
 private:
     struct Impl;

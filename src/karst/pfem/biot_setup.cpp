@@ -16,7 +16,9 @@ BiotOptions biot_options(const Model& model) {
     options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
     options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
     options.polyhedral = pe.mfem_polyhedra;
-    options.linear_solver = pe.amg ? LinearSolver::Amg : LinearSolver::Direct;
+    options.linear_solver = pe.linear_solver == "amg"      ? LinearSolver::Amg
+                            : pe.linear_solver == "direct" ? LinearSolver::Direct
+                                                           : LinearSolver::Auto;
     return options;
 }
 

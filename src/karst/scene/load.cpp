@@ -143,7 +143,7 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.fixed_strain = pe["splitting"] == "fixed_strain";
     s.poroelastic.pressure_from_pore_water = pe["pressure_source"] == "pore_water";
     s.poroelastic.mfem_polyhedra = pe["shape_functions"] == "mfem_polyhedra";
-    s.poroelastic.amg = pe["linear_solver"] == "amg";
+    s.poroelastic.linear_solver = pe["linear_solver"];
     s.poroelastic.coupled_fragments = pe["coupled_fragments"] == "anchored";
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];

@@ -105,7 +105,7 @@ struct PoroelasticSettings {
     bool fixed_strain = false;       ///< the paper's splitting instead of fixed-stress
     bool pressure_from_pore_water = true;  ///< seed p^n from M5 each call (else carry the Biot p)
     bool mfem_polyhedra = false;     ///< M21 shape functions instead of P1
-    bool amg = false;                ///< BoomerAMG-preconditioned CG instead of CHOLMOD
+    std::string linear_solver = "auto";  ///< auto | direct | amg (LinearSolver in pfem/biot.hpp)
     bool coupled_fragments = true;   ///< Biot on anchored fragments in coupled scenes
     int max_iterations = 5;
     Real tolerance = 1e-3;
