@@ -1,6 +1,7 @@
-// The Biot step inside a coupled run (method.md §5.3-5.4, issue 4): a water layer resting on an
-// anchored soil block loads it through the fluid reactions, and the block settles as a Biot
-// solve with the equivalent uniform traction on its top says.
+// The Biot step inside a coupled run (method.md §5.3-5.4, §4.10, issue 4): a water layer resting
+// on an anchored soil block loads it through the fluid reactions, the block settles as a Biot
+// solve with the equivalent uniform traction on its top says, and its particles follow; a block
+// soft enough to distort its mesh is remeshed.
 #include "support/simulate.hpp"
 
 #include "karst/core/parallel.hpp"
@@ -15,7 +16,8 @@ namespace {
 // water, q = rho0 g H = 981 Pa. Its sides touch the tank walls, so they are anchored with its
 // base; the top is free. (On a 0.2 m tank the side walls carried 6 % of the water's weight
 // through the fluid along their foot.)
-constexpr const char* k_scene = R"({
+std::string loaded_block_scene(Real youngs_modulus) {
+    return R"({
   "name": "loaded_block", "particle_spacing": 0.02,
   "time": { "fixed_dt": 0.002 },
   "fluid": { "artificial_viscosity": 0.02 },
@@ -23,9 +25,26 @@ constexpr const char* k_scene = R"({
   "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.4] } } ],
   "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.06] },
                        "material": { "porosity": 0.3, "permeability": 1e-9, "initial_saturation": 1,
-                                     "youngs_modulus": 1e5, "poisson_ratio": 0.25, "absorption_factor": 0.01 } } ],
+                                     "youngs_modulus": )" +
+           std::to_string(youngs_modulus) + R"(, "poisson_ratio": 0.25, "absorption_factor": 0.01 } } ],
   "poroelastic": { "time_step": 0.02, "permeability_feedback": false }
 })";
+}
+
+/// Mean height change of the particles whose rest height is at least `z`, m.
+Real mean_sinking(const PorousParticles& p, const std::vector<Vec3>& rest_by_id, Real z) {
+    Real sum = 0;
+    int count = 0;
+    for (Index i = 0; i < p.size(); ++i)
+        if (rest_by_id[p.id[i]][2] >= z) sum += p.x[i][2] - rest_by_id[p.id[i]][2], ++count;
+    return sum / count;
+}
+
+std::vector<Vec3> positions_by_id(const PorousParticles& p) {
+    std::vector<Vec3> x(p.size());
+    for (Index i = 0; i < p.size(); ++i) x[p.id[i]] = p.x[i];
+    return x;
+}
 
 const PointArray& array(const PointSet& set, const std::string& name) {
     for (const PointArray& a : set.arrays)
@@ -35,9 +54,10 @@ const PointArray& array(const PointSet& set, const std::string& name) {
 
 TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquivalentTraction) {
     ThreadLimit one(1);
-    test::Simulation sim(k_scene);
+    test::Simulation sim(loaded_block_scene(1e5));
     FragmentStructures structures(sim.model, sim.state.porous);
     ASSERT_FALSE(structures.empty());
+    const std::vector<Vec3> rest = positions_by_id(sim.state.porous.particles);
     const Real g = 9.81, fluid_weight = g * sim.model.particle_mass * Real(sim.state.fluid.size());
     Real load_sum = 0;
     int samples = 0;
@@ -82,6 +102,32 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
     // The rest: the boundary forces reach h = 2 dx, so the second particle layer takes part of
     // the load and less soil is compressed, and P^p > 0 where water pressed in pushes back.
     EXPECT_NEAR(coupled_top, reference_top, 0.12 * std::abs(reference_top)) << "mean top settlement, m";
+
+    // 3. The particles follow: the top layer sits at X + u of the call before the last (they move
+    //    toward the last call's u over the next interval), which the steady load leaves unchanged.
+    EXPECT_NEAR(mean_sinking(sim.state.porous.particles, rest, top - 1e-9), coupled_top, 0.03 * std::abs(coupled_top)) << "m";
+}
+
+TEST(CoupledStructure, AJellySoftBlockDistortsItsMeshAndIsRemeshedOnItsDeformedShape) {
+    // E = 1 kPa: the water's 981 Pa would compress it by 80 % in linear theory, so the first calls
+    // flatten elements below 2 degrees and it is remeshed on its deformed positions (§4.10).
+    ThreadLimit one(1);
+    test::Simulation sim(loaded_block_scene(1e3));
+    FragmentStructures structures(sim.model, sim.state.porous);
+    const std::vector<Vec3> rest = positions_by_id(sim.state.porous.particles);
+    const Real dx = sim.model.dx;
+    while (sim.state.time < 0.3 - 1e-9) step(sim.model, sim.state, 0.002, sim.profile, &structures);
+    EXPECT_GE(structures.timings().remeshes, 1);
+    // The remeshes carry the deformation on: the top has sunk by over a quarter of a spacing, and
+    // no particle left the tank or the block's footprint.
+    EXPECT_LT(mean_sinking(sim.state.porous.particles, rest, 0.05 - 1e-9), -0.25 * dx);
+    for (const Vec3& x : sim.state.porous.particles.x) {
+        ASSERT_TRUE(x.allFinite());
+        EXPECT_GT(x[2], -0.5 * dx);
+        EXPECT_GT(x.head<2>().minCoeff(), -0.5 * dx);
+        EXPECT_LT(x.head<2>().maxCoeff(), 0.4 + 0.5 * dx);
+    }
+    EXPECT_EQ(sim.state.porous.particles.size(), Index(rest.size()));
 }
 
 }  // namespace

@@ -14,6 +14,10 @@ namespace {
 /// nodes keep their stiffness and take no load.
 constexpr Real k_remesh_lost_fraction = 0.01;
 
+/// §4.10: a deformed element with a dihedral angle under this many degrees (or inverted) triggers
+/// a remesh. Interior slivers that were under it at rest (tet_mesh.hpp) do not count.
+constexpr Real k_distorted_dihedral_deg = 2;
+
 }  // namespace
 
 struct FragmentStructures::Structure {
@@ -25,6 +29,9 @@ struct FragmentStructures::Structure {
     BiotFields fields;
     std::vector<Mat3> node_tensors;     ///< K0 per node
     std::vector<Real> assembled_scale;  ///< per tet, for refresh_mobility
+    std::vector<char> well_shaped;      ///< per tet: dihedral angles of at least 2 degrees at rest
+    bool distorted = false;             ///< the last call left a distorted element: remesh before the next
+    std::vector<Vec3> u_from;           ///< per node: u of the call before the last (the motion's start)
 };
 
 FragmentStructures::FragmentStructures(const Model& model, const PorousState& porous) {
@@ -32,8 +39,13 @@ FragmentStructures::FragmentStructures(const Model& model, const PorousState& po
     Index ids = 0;
     for (Index i = 0; i < p.size(); ++i) ids = std::max(ids, p.id[i] + 1);
     m_impulse.assign(ids, Vec3::Zero()), m_u.assign(ids, Vec3::Zero()), m_rest_tensor.assign(ids, Mat3::Zero());
+    m_rest_x.assign(ids, Vec3::Zero());
     m_paired_scale.assign(ids, 1), m_paired_volume.assign(ids, 0);
-    for (Index i = 0; i < p.size(); ++i) m_rest_tensor[p.id[i]] = p.body_permeability[i], m_paired_volume[p.id[i]] = p.volume[i];
+    for (Index i = 0; i < p.size(); ++i) {
+        const Index id = p.id[i];
+        m_rest_tensor[id] = p.body_permeability[i], m_paired_volume[id] = p.volume[i];
+        m_rest_x[id] = p.x[i];
+    }
     for (size_t f = 0; f < porous.fragments.size(); ++f) {
         if (!porous.fragments[f].anchored || porous.fragments[f].mass <= 0) continue;
         // The fragment's solid: its members share one material.
@@ -53,17 +65,18 @@ FragmentStructures::~FragmentStructures() = default;
 
 void FragmentStructures::build(const Model& model, const PorousState& porous, Structure& s) {
     // An anchored fragment never moves or turns, so its rest frame is the world frame: the mesh
-    // lives at the particles' world positions, where the scene's regions and walls are.
+    // lives at the particles' world rest positions X, where the scene's regions and walls are.
     const PorousParticles& p = porous.particles;
     std::vector<Vec3> x;
     s.node_id.clear();
     for (Index i = 0; i < p.size(); ++i)
-        if (p.fragment[i] == s.fragment) x.push_back(p.x[i]), s.node_id.push_back(p.id[i]);
+        if (p.fragment[i] == s.fragment) x.push_back(m_rest_x[p.id[i]]), s.node_id.push_back(p.id[i]);
     s.solver.reset();  // it refers to the old mesh
     s.mesh = mesh_points(model, x, m_timings);
     s.node_tensors.resize(x.size());
     s.fields.u.resize(x.size()), s.fields.p.assign(x.size(), 0);
     for (size_t a = 0; a < x.size(); ++a) s.node_tensors[a] = m_rest_tensor[s.node_id[a]], s.fields.u[a] = m_u[s.node_id[a]];
+    s.u_from = s.fields.u;
     // [D] Geostatic start: a coupled fragment's rest state is its state at rest under its own
     // weight, so gravity (body force and gravity flux) leaves the problem and u, eps_v and p are
     // the response to the fluid's loads and to the pore overpressure P^p (M5, zero up to S = 1).
@@ -74,6 +87,23 @@ void FragmentStructures::build(const Model& model, const PorousState& porous, St
     problem.gravity = Vec3::Zero();
     s.solver.emplace(make_biot_solver(model, s.mesh, std::move(problem), m_timings));
     s.assembled_scale.assign(s.mesh.tet_count(), 1);
+    s.well_shaped.resize(s.mesh.tet_count());
+    for (Index e = 0; e < s.mesh.tet_count(); ++e) {
+        const Tet& t = s.mesh.tets[e];
+        s.well_shaped[e] = min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) >= k_distorted_dihedral_deg;
+    }
+}
+
+bool FragmentStructures::distorted(const Structure& s) const {
+    std::vector<Vec3> x(s.mesh.node_count());
+    for (Index a = 0; a < s.mesh.node_count(); ++a) x[a] = s.mesh.nodes[a] + s.fields.u[a];
+    for (Index e = 0; e < s.mesh.tet_count(); ++e) {
+        if (!s.well_shaped[e]) continue;
+        const Tet& t = s.mesh.tets[e];
+        if (signed_volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) <= 0 || min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) < k_distorted_dihedral_deg)
+            return true;
+    }
+    return false;
 }
 
 void FragmentStructures::add_loads(const PorousParticles& particles, const std::vector<Vec3>& force, Real dt) {
@@ -81,15 +111,38 @@ void FragmentStructures::add_loads(const PorousParticles& particles, const std::
     m_elapsed += dt;
 }
 
+void FragmentStructures::follow_displacement(PorousParticles& p, const std::vector<Index>& index_of, Real fraction, Real dt_B) const {
+    for (const auto& owned : m_structures) {
+        const Structure& s = *owned;
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            const Index i = index_of[s.node_id[a]];
+            if (i < 0) continue;
+            const Vec3 change = s.fields.u[a] - s.u_from[a];
+            p.x[i] = m_rest_x[s.node_id[a]] + s.u_from[a] + fraction * change;
+            p.v[i] = fraction < 1 ? Vec3(change / dt_B) : Vec3::Zero();
+        }
+    }
+}
+
 bool FragmentStructures::advance(const Model& model, PorousState& porous) {
-    const Real dt = m_elapsed;
-    if (m_structures.empty() || dt < model.scene.poroelastic.time_step * (1 - 1e-9)) return false;
+    if (m_structures.empty()) return false;
+    const Real dt = m_elapsed, dt_B = model.scene.poroelastic.time_step;
     PorousParticles& p = porous.particles;
     std::vector<Index> index_of(m_impulse.size(), -1);
     for (Index i = 0; i < p.size(); ++i) index_of[p.id[i]] = i;
+    // The particles move from X + u^{n-1} to X + u^n over the interval after the call that gave
+    // u^n, at the velocity of that change [D]: set at once, a call's displacement moved the fluid's
+    // boundary by up to 2 % of a spacing within one step (cave_soak), and the pressure spikes it
+    // raised took cave_soak from 341 to 440 steps. The pairs need no rebuild for it: their
+    // conductances hold the distances between members, which change with the strain (caught by
+    // the volume test below), not with the displacement; rebuilding them whenever a particle had
+    // moved 1 % of a spacing cost 0.24 s each, ten times in cave_soak's first 0.5 s, and changed
+    // its absorbed water by 3e-5.
+    follow_displacement(p, index_of, std::min<Real>(1, dt / dt_B), dt_B);
+    if (dt < dt_B * (1 - 1e-9)) return false;
+    bool stale = false;
     const bool feedback = model.scene.poroelastic.permeability_feedback;
     const Real rest_volume = model.dx * model.dx * model.dx;
-    bool stale = false;
     for (auto& owned : m_structures) {
         Structure& s = *owned;
         const Index n = s.mesh.node_count();
@@ -97,6 +150,13 @@ bool FragmentStructures::advance(const Model& model, PorousState& porous) {
         for (Index a = 0; a < n; ++a) lost += index_of[s.node_id[a]] < 0;
         if (lost > k_remesh_lost_fraction * n) {
             for (Index a = 0; a < n; ++a) m_u[s.node_id[a]] = s.fields.u[a];
+            build(model, porous, s);
+            ++m_timings.remeshes;
+        } else if (s.distorted) {
+            // [D] A distorted mesh is rebuilt on the deformed positions, which become the new
+            // rest state (u = 0 there): small-strain Biot cannot carry a deformation that inverts
+            // elements, so the stress it held is released, as in a soil that has flowed.
+            for (Index a = 0; a < n; ++a) m_rest_x[s.node_id[a]] += s.fields.u[a], m_u[s.node_id[a]] = Vec3::Zero();
             build(model, porous, s);
             ++m_timings.remeshes;
         }
@@ -110,10 +170,12 @@ bool FragmentStructures::advance(const Model& model, PorousState& porous) {
             s.fields.p[a] = law.pore_pressure(law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
         }
         s.solver->set_extra_loads(loads);
+        s.u_from = s.fields.u;  // where the particles are now
         const BiotCallReport r = s.solver->advance(dt, s.fields);
         m_timings.factorisation += r.seconds_flow_factorisation, m_timings.iterations += r.seconds_iterations;
         ++m_timings.biot_calls, m_timings.biot_iterations += r.iterations;
         m_timings.all_converged = m_timings.all_converged && r.converged;
+        s.distorted = distorted(s);
         if (!feedback) continue;
         // Feedback (§5.4): porosity, bulk volume V = V0 (1 + eps_v) and K = (k/k0) R K0 R^T.
         const NodalStress stress = nodal_stress(s.mesh, s.solver->problem().material, s.fields);

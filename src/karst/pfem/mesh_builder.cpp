@@ -48,26 +48,6 @@ using Regular = CGAL::Regular_triangulation_3<K, CGAL::Triangulation_data_struct
 
 Vec3 to_vec(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
 
-Real signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-    return (b - a).cross(c - a).dot(d - a) / 6;
-}
-
-/// Smallest dihedral angle of a tet, in degrees.
-Real min_dihedral_deg(const std::array<Vec3, 4>& x) {
-    // The dihedral angle at edge (i,j) is the angle between the faces (i,j,k) and (i,j,l),
-    // computed from the face normals: pi minus the angle between the outward normals.
-    static constexpr int edges[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}, {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};
-    Real smallest = 180;
-    for (const auto& e : edges) {
-        const Vec3 axis = (x[e[1]] - x[e[0]]).normalized();
-        Vec3 a = x[e[2]] - x[e[0]], b = x[e[3]] - x[e[0]];
-        a -= a.dot(axis) * axis, b -= b.dot(axis) * axis;
-        const Real cosine = std::clamp(a.dot(b) / (a.norm() * b.norm()), Real(-1), Real(1));
-        smallest = std::min(smallest, std::acos(cosine) * 180 / std::numbers::pi);
-    }
-    return smallest;
-}
-
 struct UnionFind {
     std::vector<Index> parent;
     explicit UnionFind(Index n) : parent(n) { std::iota(parent.begin(), parent.end(), Index(0)); }
@@ -185,14 +165,6 @@ std::vector<std::pair<Point, Index>> indexed(std::span<const Vec3> points, const
 
 }  // namespace
 
-Real TetMesh::tet_volume(Index e) const {
-    const Tet& t = tets[e];
-    return signed_volume(nodes[t[0]], nodes[t[1]], nodes[t[2]], nodes[t[3]]);
-}
-
-Vec3 TetMesh::area_vector(const Triangle& t) const {
-    return 0.5 * (nodes[t[1]] - nodes[t[0]]).cross(nodes[t[2]] - nodes[t[0]]);
-}
 
 TetMesh build_tet_mesh(std::span<const Vec3> points, std::span<const Real> node_size, const MeshOptions& options,
                        std::span<const Real> weights) {

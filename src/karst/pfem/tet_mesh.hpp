@@ -54,6 +54,12 @@ struct TetMesh {
 TetMesh build_tet_mesh(std::span<const Vec3> points, std::span<const Real> node_size, const MeshOptions& options,
                        std::span<const Real> weights = {});
 
+/// Volume of the tet (a, b, c, d): positive when (b - a, c - a, d - a) is right-handed, m^3.
+Real signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// Smallest dihedral angle of a tet, in degrees.
+Real min_dihedral_deg(const std::array<Vec3, 4>& x);
+
 /// Bare CGAL Delaunay of the same points, for benchmarks: returns the number of finite cells.
 Index bare_delaunay_cell_count(std::span<const Vec3> points);
 
