@@ -456,10 +456,9 @@ struct BiotSolver::Impl {
         // Predictor [D]: u^0 is the drained response to this call's loads at p^n rather than u^n.
         // With u^0 = u^n the first flow solve of a call whose loads jumped sees no volume change
         // and returns p^n, so one of the five iterations is wasted; where the loads did not
-        // change, the two starts agree.
-        // A call whose loads and p^n are those of the previous call's last mechanics solve, from
-        // the u that solve returned (a poroelastic-only run under steady loads), has that u as its
-        // predictor: the solve is skipped.
+        // change, the two starts agree. So a call whose loads and p^n are those of the previous
+        // call's last mechanics solve, from the u that solve returned (a poroelastic-only run
+        // under steady loads), has that u as its predictor and skips the solve.
         const Vector rhs_predictor = u_dofs.gather_free(f_ext + Q * p) - elastic_lift;
         const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() && rhs_predictor == last_elastic_rhs && u == last_elastic_u;
         if (!as_last_solve) u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u), ++report.elastic_solves;

@@ -59,8 +59,8 @@ enum class Splitting { FixedStress, FixedStrain };
 ///    sets up in 0.1 s and solves in 14 iterations; the flow matrix changes with dt and with the
 ///    mobility (every call under permeability feedback), so AMG wins on big meshes.
 /// Auto (the default) factorises the elasticity and picks the flow solver by size
-/// (BiotOptions::amg_flow_unknowns). Amg suits a mesh rebuilt at nearly every call, or one too big for the
-/// elastic factor's memory (1.8 GB at 70,000 nodes).
+/// (BiotOptions::amg_flow_unknowns). Amg suits a mesh rebuilt at nearly every call, or one too
+/// big for the elastic factor's memory (1.8 GB at 70,000 nodes).
 enum class LinearSolver { Auto, Direct, Amg };
 
 struct BiotOptions {
