@@ -160,14 +160,16 @@ bool FragmentStructures::advance(const Model& model, PorousState& porous) {
             build(model, porous, s);
             ++m_timings.remeshes;
         }
-        // Loads: the mean force since the last call (§5.3); p^n <- P^p (M5) from the pore water.
+        // Loads: the mean force since the last call (§5.3); p^n <- P^p (M5) from the pore water,
+        // or the Biot pressure carried from the last call (/poroelastic/pressure_source biot).
         const PoreWaterLaw& law = model.pore_laws[s.solid - model.scene.porous_solids.data()];
+        const bool from_pore_water = model.scene.poroelastic.pressure_from_pore_water;
         std::vector<Vec3> loads(s.mesh.node_count(), Vec3::Zero());
         for (Index a = 0; a < s.mesh.node_count(); ++a) {
             const Index i = index_of[s.node_id[a]];
             if (i < 0) continue;
             loads[a] = m_impulse[s.node_id[a]] / dt;
-            s.fields.p[a] = law.pore_pressure(law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
+            if (from_pore_water) s.fields.p[a] = law.pore_pressure(law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
         }
         s.solver->set_extra_loads(loads);
         s.u_from = s.fields.u;  // where the particles are now
