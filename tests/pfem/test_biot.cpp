@@ -288,7 +288,8 @@ TEST(Biot, FixedStressConvergesWhereFixedStrainDivergesWhenTauExceedsOne) {
     BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 100, 1e-13}).advance(1.0, reference);
 
     BiotFields stress_split = column.zero();
-    const BiotCallReport fs = BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 5, 1e-3}).advance(1.0, stress_split);
+    const BiotOptions plain{Splitting::FixedStress, 5, 1e-3, 0};  // M22 as the sheet has it, no acceleration
+    const BiotCallReport fs = BiotSolver(column.mesh, column.problem, plain).advance(1.0, stress_split);
     EXPECT_TRUE(fs.converged);
     EXPECT_LE(fs.iterations, 5);
     Real p_err = 0, p_ref = 0;
@@ -304,6 +305,30 @@ TEST(Biot, FixedStressConvergesWhereFixedStrainDivergesWhenTauExceedsOne) {
     const BiotCallReport fx = BiotSolver(column.mesh, column.problem, {Splitting::FixedStrain, 50, 1e-3}).advance(1.0, strain_split);
     EXPECT_FALSE(fx.converged) << "the fixed-strain split needs tau < 1";
     EXPECT_GT(fx.p_change.back(), 0.1) << "fixed-strain iterates still change by over 10 % after 50 iterations";
+}
+
+TEST(Biot, AndersonMixingReachesTheFixedStressAnswerInFewerIterations) {
+    // tau = 5: the plain fixed-stress split contracts slowly. Anderson mixing of the pressure
+    // iterates reaches the same fields (both within 1 % of the answer iterated to round-off) in
+    // fewer iterations: measured 5 against 7 here (errors 0.07 % and 0.2 %).
+    UndrainedColumn column;
+    BiotMaterial& m = column.problem.material;
+    m.storage = 1 / (5 * m.drained_bulk_modulus());
+    ASSERT_NEAR(m.coupling_strength(), 5, 1e-12);
+    BiotFields reference = column.zero(), plain = column.zero(), mixed = column.zero();
+    BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 200, 1e-13, 0}).advance(1.0, reference);
+    const BiotCallReport p = BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 50, 1e-3, 0}).advance(1.0, plain);
+    const BiotCallReport a = BiotSolver(column.mesh, column.problem, {Splitting::FixedStress, 50, 1e-3, 3}).advance(1.0, mixed);
+    ASSERT_TRUE(p.converged && a.converged);
+    EXPECT_LE(a.iterations, p.iterations - 2);
+    Real plain_err = 0, mixed_err = 0, p_ref = 0;
+    for (Index i = 0; i < column.mesh.node_count(); ++i) {
+        plain_err = std::max(plain_err, std::abs(plain.p[i] - reference.p[i]));
+        mixed_err = std::max(mixed_err, std::abs(mixed.p[i] - reference.p[i]));
+        p_ref = std::max(p_ref, std::abs(reference.p[i]));
+    }
+    EXPECT_LT(plain_err, 1e-2 * p_ref);
+    EXPECT_LT(mixed_err, 1e-2 * p_ref);
 }
 
 }  // namespace

@@ -67,6 +67,9 @@ struct BiotOptions {
     Splitting splitting = Splitting::FixedStress;
     int max_iterations = 5;   ///< M22: k_max
     Real tolerance = 1e-3;    ///< M22 stopping test on relative changes of p and u
+    /// Anderson acceleration of the fixed-stress pressure iterates over this many previous ones
+    /// (0: the plain M22 iteration).
+    int anderson_depth = 3;
     /// M21: EDT polyhedra with Laplace shape functions instead of P1 tets (method.md §5.2).
     bool polyhedral = false;
     LinearSolver linear_solver = LinearSolver::Auto;

@@ -15,6 +15,7 @@ BiotOptions biot_options(const Model& model) {
     BiotOptions options;
     options.splitting = pe.fixed_strain ? Splitting::FixedStrain : Splitting::FixedStress;
     options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
+    if (!pe.anderson) options.anderson_depth = 0;
     options.polyhedral = pe.mfem_polyhedra;
     options.linear_solver = pe.linear_solver == "amg"      ? LinearSolver::Amg
                             : pe.linear_solver == "direct" ? LinearSolver::Direct

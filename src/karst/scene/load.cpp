@@ -146,6 +146,7 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.linear_solver = pe["linear_solver"];
     s.poroelastic.coupled_fragments = pe["coupled_fragments"] == "anchored";
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
+    s.poroelastic.anderson = pe["acceleration"] == "anderson";
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
     s.poroelastic.weighted_alpha = pe["weighted_alpha"];
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];

@@ -108,6 +108,7 @@ struct PoroelasticSettings {
     std::string linear_solver = "auto";  ///< auto | direct | amg (LinearSolver in pfem/biot.hpp)
     bool coupled_fragments = true;   ///< Biot on anchored fragments in coupled scenes
     int max_iterations = 5;
+    bool anderson = true;            ///< Anderson-accelerated fixed-stress iterations
     Real tolerance = 1e-3;
     bool permeability_feedback = true;  ///< §5.4 after every call
     Real alpha = 1.25;               ///< M19
