@@ -139,7 +139,8 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     // eps_v = -q / (E_oed + B^2 M) and p = B M q / (E_oed + B^2 M) throughout (Skempton's
     // one-dimensional loading efficiency).
     // tau = B^2 M / K_dr = 5 here: the fixed-stress split contracts by about 0.45 per iteration,
-    // so reaching the 1e-3 test takes about 11 iterations (5, M22's default, leave 2e-2).
+    // so reaching the 1e-3 test takes about 11 plain iterations, or 6.5 with Anderson mixing (the
+    // default); M22's default of 5 leaves about 2e-2.
     ThreadLimit one(1);
     test::Simulation sim(loaded_block_scene(1e5, R"(, "pressure_source": "biot", "max_iterations": 20)"));
     FragmentStructures structures(sim.model, sim.state.porous);
