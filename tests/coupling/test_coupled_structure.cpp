@@ -43,6 +43,21 @@ Real mean_sinking(const PorousParticles& p, const std::vector<Vec3>& rest_by_id,
     return sum / count;
 }
 
+/// Steps to `end` with dt = 2 ms and the Biot step; returns the mean downward force of the fluid
+/// on the porous particles after `from`, N.
+Real run_and_mean_load(test::Simulation& sim, FragmentStructures& structures, Real from, Real end) {
+    Real sum = 0;
+    int samples = 0;
+    while (sim.state.time < end - 1e-9) {
+        step(sim.model, sim.state, 0.002, sim.profile, &structures);
+        if (sim.state.time > from) {
+            for (const Vec3& f : sim.state.porous_scratch.force) sum -= f[2];
+            ++samples;
+        }
+    }
+    return sum / samples;
+}
+
 std::vector<Vec3> positions_by_id(const PorousParticles& p) {
     std::vector<Vec3> x(p.size());
     for (Index i = 0; i < p.size(); ++i) x[p.id[i]] = p.x[i];
@@ -62,19 +77,10 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
     ASSERT_FALSE(structures.empty());
     const std::vector<Vec3> rest = positions_by_id(sim.state.porous.particles);
     const Real g = 9.81, fluid_weight = g * sim.model.particle_mass * Real(sim.state.fluid.size());
-    Real load_sum = 0;
-    int samples = 0;
-    while (sim.state.time < 1.0 - 1e-9) {
-        step(sim.model, sim.state, 0.002, sim.profile, &structures);
-        if (sim.state.time > 0.6) {
-            Real fz = 0;
-            for (const Vec3& f : sim.state.porous_scratch.force) fz += f[2];
-            load_sum += fz, ++samples;
-        }
-    }
+    const Real load = run_and_mean_load(sim, structures, 0.6, 1.0);
     // 1. The block carries the water's weight (less the little it absorbed): the loads are right.
     const Real water_weight = fluid_weight - g * sim.state.porous.absorbed;
-    EXPECT_NEAR(-load_sum / samples, water_weight, 0.05 * water_weight) << "mean vertical fluid load over 0.6-1 s, N";
+    EXPECT_NEAR(load, water_weight, 0.05 * water_weight) << "mean vertical fluid load over 0.6-1 s, N";
     EXPECT_EQ(structures.timings().biot_calls, 50);
 
     // 2. Its top settles as a drained Biot solve of the same mesh under the same mean load as a
@@ -88,7 +94,7 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
                                          std::vector<Mat3>(mesh.node_count(), 1e-9 * Mat3::Identity()));
     reference.gravity = Vec3::Zero();
     reference.drained.assign(mesh.node_count(), 1);
-    const Real top = 0.05, q = -load_sum / samples / (0.4 * 0.4);
+    const Real top = 0.05, q = load / (0.4 * 0.4);
     reference.nodal_force = traction_loads(mesh, Vec3(0, 0, -q), [&](const Vec3& x) { return x[2] > top - 1e-9; });
     BiotFields drained{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
     BiotSolver(mesh, reference).advance(1.0, drained);
@@ -144,20 +150,11 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     ThreadLimit one(1);
     test::Simulation sim(loaded_block_scene(1e5, R"(, "pressure_source": "biot", "max_iterations": 20)"));
     FragmentStructures structures(sim.model, sim.state.porous);
-    Real load_sum = 0;
-    int samples = 0;
-    while (sim.state.time < 0.8 - 1e-9) {
-        step(sim.model, sim.state, 0.002, sim.profile, &structures);
-        if (sim.state.time > 0.5) {
-            Real fz = 0;
-            for (const Vec3& f : sim.state.porous_scratch.force) fz += f[2];
-            load_sum += fz, ++samples;
-        }
-    }
+    const Real load = run_and_mean_load(sim, structures, 0.5, 0.8);
     EXPECT_TRUE(structures.timings().all_converged);
     const BiotMaterial m = biot_material(sim.model, sim.model.scene.porous_solids[0].material);
     const Real M = 1 / m.storage, E_oed = m.lame_lambda() + 2 * m.shear_modulus();
-    const Real q = -load_sum / samples / (0.4 * 0.4);
+    const Real q = load / (0.4 * 0.4);
     const Real undrained = m.biot_coefficient * M * q / (E_oed + m.biot_coefficient * m.biot_coefficient * M);
     MeshFrame frame;
     structures.append_to(frame);
