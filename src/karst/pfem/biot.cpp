@@ -226,7 +226,7 @@ struct BiotSolver::Impl {
         elastic_iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
         flow_iterative = options.linear_solver == LinearSolver::Amg ||
                          (options.linear_solver == LinearSolver::Auto && p_dofs.free_count >= options.amg_flow_unknowns);
-        elastic.compute(K_ff, elastic_iterative, elastic_amg_options());
+        elastic.compute(K_ff, elastic_iterative, elastic_iterative ? elastic_amg_options() : AmgOptions{});
         t_elastic_factor = factor_watch.seconds();
     }
 

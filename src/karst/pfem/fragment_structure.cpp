@@ -21,6 +21,7 @@ constexpr Real k_distorted_dihedral_deg = 2;
 }  // namespace
 
 struct FragmentStructures::Structure {
+    Index slot = 0;  ///< its place in m_structures
     Index fragment = 0;
     const PorousSolid* solid = nullptr;
     std::vector<Index> node_id;  ///< particle id of each node
@@ -39,7 +40,7 @@ FragmentStructures::FragmentStructures(const Model& model, const PorousState& po
     Index ids = 0;
     for (Index i = 0; i < p.size(); ++i) ids = std::max(ids, p.id[i] + 1);
     m_impulse.assign(ids, Vec3::Zero()), m_u.assign(ids, Vec3::Zero()), m_rest_tensor.assign(ids, Mat3::Zero());
-    m_rest_x.assign(ids, Vec3::Zero());
+    m_rest_x.assign(ids, Vec3::Zero()), m_node_of.assign(ids, {-1, -1});
     m_paired_scale.assign(ids, 1), m_paired_volume.assign(ids, 0);
     for (Index i = 0; i < p.size(); ++i) {
         const Index id = p.id[i];
@@ -55,7 +56,7 @@ FragmentStructures::FragmentStructures(const Model& model, const PorousState& po
         const PorousSolid& solid = model.scene.porous_solids[material];
         if (solid.material.porosity < k_min_porosity) continue;  // impermeable: no pore pressure, a rigid boundary
         auto s = std::make_unique<Structure>();
-        s->fragment = Index(f), s->solid = &solid;
+        s->slot = Index(m_structures.size()), s->fragment = Index(f), s->solid = &solid;
         build(model, porous, *s);
         m_structures.push_back(std::move(s));
     }
@@ -73,6 +74,7 @@ void FragmentStructures::build(const Model& model, const PorousState& porous, St
         if (p.fragment[i] == s.fragment) x.push_back(m_rest_x[p.id[i]]), s.node_id.push_back(p.id[i]);
     s.solver.reset();  // it refers to the old mesh
     s.mesh = mesh_points(model, x, m_timings);
+    for (size_t a = 0; a < x.size(); ++a) m_node_of[s.node_id[a]] = {s.slot, Index(a)};
     s.node_tensors.resize(x.size());
     s.fields.u.resize(x.size()), s.fields.p.assign(x.size(), 0);
     for (size_t a = 0; a < x.size(); ++a) s.node_tensors[a] = m_rest_tensor[s.node_id[a]], s.fields.u[a] = m_u[s.node_id[a]];
@@ -111,25 +113,21 @@ void FragmentStructures::add_loads(const PorousParticles& particles, const std::
     m_elapsed += dt;
 }
 
-void FragmentStructures::follow_displacement(PorousParticles& p, const std::vector<Index>& index_of, Real fraction, Real dt_B) const {
-    for (const auto& owned : m_structures) {
-        const Structure& s = *owned;
-        for (Index a = 0; a < s.mesh.node_count(); ++a) {
-            const Index i = index_of[s.node_id[a]];
-            if (i < 0) continue;
-            const Vec3 change = s.fields.u[a] - s.u_from[a];
-            p.x[i] = m_rest_x[s.node_id[a]] + s.u_from[a] + fraction * change;
-            p.v[i] = fraction < 1 ? Vec3(change / dt_B) : Vec3::Zero();
-        }
-    }
+void FragmentStructures::follow_displacement(PorousParticles& p, Real fraction, Real dt_B) const {
+    parallel_for(p.size(), [&](Index i) {
+        const auto [slot, a] = m_node_of[p.id[i]];
+        if (slot < 0) return;
+        const Structure& s = *m_structures[slot];
+        const Vec3 change = s.fields.u[a] - s.u_from[a];
+        p.x[i] = m_rest_x[p.id[i]] + s.u_from[a] + fraction * change;
+        p.v[i] = fraction < 1 ? Vec3(change / dt_B) : Vec3::Zero();
+    });
 }
 
 bool FragmentStructures::advance(const Model& model, PorousState& porous) {
     if (m_structures.empty()) return false;
     const Real dt = m_elapsed, dt_B = model.scene.poroelastic.time_step;
     PorousParticles& p = porous.particles;
-    std::vector<Index> index_of(m_impulse.size(), -1);
-    for (Index i = 0; i < p.size(); ++i) index_of[p.id[i]] = i;
     // The particles move from X + u^{n-1} to X + u^n over the interval after the call that gave
     // u^n, at the velocity of that change [D]: set at once, a call's displacement moved the fluid's
     // boundary by up to 2 % of a spacing within one step (cave_soak), and that run took 440
@@ -138,8 +136,10 @@ bool FragmentStructures::advance(const Model& model, PorousState& porous) {
     // (caught by the volume test below), not with the displacement; rebuilding them whenever a
     // particle had moved 1 % of a spacing cost 0.24 s each, ten times in cave_soak's first 0.5 s,
     // and changed its absorbed water by 3e-5 kg.
-    follow_displacement(p, index_of, std::min<Real>(1, dt / dt_B), dt_B);
+    follow_displacement(p, std::min<Real>(1, dt / dt_B), dt_B);
     if (dt < dt_B * (1 - 1e-9)) return false;
+    std::vector<Index> index_of(m_impulse.size(), -1);
+    for (Index i = 0; i < p.size(); ++i) index_of[p.id[i]] = i;
     bool stale = false;
     const bool feedback = model.scene.poroelastic.permeability_feedback;
     const Real rest_volume = model.dx * model.dx * model.dx;

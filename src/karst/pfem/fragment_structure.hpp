@@ -9,6 +9,7 @@
 #include "karst/sim/state.hpp"
 
 #include <memory>
+#include <utility>
 
 namespace karst {
 
@@ -46,12 +47,13 @@ private:
     void build(const Model& model, const PorousState& porous, Structure& s);
     bool distorted(const Structure& s) const;
     /// Moves the particles the given fraction of the way from X + u^{n-1} to X + u^n.
-    void follow_displacement(PorousParticles& p, const std::vector<Index>& index_of, Real fraction, Real dt_B) const;
+    void follow_displacement(PorousParticles& p, Real fraction, Real dt_B) const;
 
     std::vector<std::unique_ptr<Structure>> m_structures;  // stable addresses: a solver refers to its mesh
     std::vector<Vec3> m_impulse;   ///< per particle id: sum of force dt since the last call, N s
     std::vector<Vec3> m_u;         ///< per particle id: last displacement (carried over a remesh), m
     std::vector<Vec3> m_rest_x;    ///< per particle id: rest position X (world = body frame when anchored), m
+    std::vector<std::pair<Index, Index>> m_node_of;  ///< per particle id: (structure, node), or (-1, -1)
     std::vector<Mat3> m_rest_tensor;  ///< per particle id: K0 in the body frame, m^2
     std::vector<Real> m_paired_scale, m_paired_volume;  ///< per particle id: k/k0 and V of the last pair build
     Real m_elapsed = 0;            ///< time since the last call, s
