@@ -6,7 +6,7 @@
 // and porous), MIPPS, seconds per stage and density errors; appends CSV to
 // bench/results/2core/<scene>.csv.
 //
-//   karst_bench_scene [--scene NAME] [--steps N] [--warmup N] [--threads N]
+//   karst_bench_scene [--scene NAME] [--steps N] [--warmup N] [--threads N] [--solver dfsph|pcisph]
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/scene/scene.hpp"
@@ -26,16 +26,22 @@ using namespace karst;
 
 int main(int argc, char** argv) {
     int steps = 50, warmup = 10, threads = 0;
-    std::string scene = "bench_dam_break_118k";
+    std::string scene = "bench_dam_break_118k", solver;
     for (int a = 1; a + 1 < argc; a += 2) {
         if (!std::strcmp(argv[a], "--scene")) scene = argv[a + 1];
         else if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
         else if (!std::strcmp(argv[a], "--warmup")) warmup = std::atoi(argv[a + 1]);
         else if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--solver")) solver = argv[a + 1];
     }
     ThreadLimit limit(threads);
     const std::string scene_path = std::string(KARST_SOURCE_DIR) + "/scenes/" + scene + ".json";
-    const Model model = build_model(load_scene_file(scene_path));
+    Scene scene_data = load_scene_file(scene_path);
+    if (solver == "pcisph") scene_data.fluid.solver = FluidSettings::Solver::Pcisph;
+    else if (solver == "dfsph") scene_data.fluid.solver = FluidSettings::Solver::Dfsph;
+    else if (!solver.empty()) { fmt::print(stderr, "--solver: dfsph or pcisph, not {}\n", solver); return 2; }
+    const bool dfsph = scene_data.fluid.solver == FluidSettings::Solver::Dfsph;
+    const Model model = build_model(scene_data);
     State state = make_initial_state(model);
     const Real dt = *model.scene.time.fixed_dt;
     StepProfile warm;
@@ -43,7 +49,7 @@ int main(int argc, char** argv) {
 
     StepProfile profile;
     std::vector<Real> errors;
-    int iterations = 0;
+    int iterations = 0, divergence_iterations = 0;
     double particle_steps = 0;
     Stopwatch watch;
     for (int k = 0; k < steps; ++k) {
@@ -51,6 +57,7 @@ int main(int argc, char** argv) {
         const StepReport r = step(model, state, dt, profile);
         errors.push_back(r.max_density_error);
         iterations += r.pressure_iterations;
+        divergence_iterations += r.divergence_iterations;
     }
     const double seconds = watch.seconds();
     std::sort(errors.begin(), errors.end());
@@ -62,8 +69,9 @@ int main(int argc, char** argv) {
     if (state.porous.size() > 0)
         fmt::print("  {:.3f} kg absorbed, {} pore-flow sub-steps per step\n", state.porous.absorbed,
                    double(state.porous.pore_substeps) / (steps + warmup));
-    fmt::print("  {:.0f} particle-steps/s, {:.4f} MIPPS, {:.1f} ms per step, {:.2f} PCISPH iterations per step\n",
-               particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps, double(iterations) / steps);
+    fmt::print("  {}: {:.0f} particle-steps/s, {:.4f} MIPPS, {:.1f} ms per step, {:.2f} density + {:.2f} divergence iterations per step\n",
+               dfsph ? "DFSPH" : "PCISPH", particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps,
+               double(iterations) / steps, double(divergence_iterations) / steps);
     fmt::print("  max density error per step: mean {:.4f} %, p99 {:.4f} %, max {:.4f} %\n", 100 * mean_error,
                100 * p99, 100 * errors.back());
     for (size_t s = 0; s < size_t(Stage::Count); ++s)
@@ -73,7 +81,7 @@ int main(int argc, char** argv) {
     gethostname(host, sizeof host - 1);
     const std::filesystem::path dir = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core";
     std::filesystem::create_directories(dir);
-    const auto file = dir / (scene + ".csv");
+    const auto file = dir / (scene + (dfsph ? "_dfsph" : "") + ".csv");
     const bool fresh = !std::filesystem::exists(file);
     std::ofstream csv(file, std::ios::app);
     if (fresh) {

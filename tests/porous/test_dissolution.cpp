@@ -22,7 +22,7 @@ TEST(Dissolution, ConvertsOnlySaturatedHighPorosityParticlesAndConservesMassSolu
         porous.permeability.push_back(Mat3::Identity() * 1e-10), porous.fragment.push_back(0);
     }
     FluidParticles fluid;  // one particle already there
-    fluid.x = {Vec3(0, 1, 0)}, fluid.v = {Vec3::Zero()}, fluid.mass = {mf0}, fluid.sph_mass = {mf0}, fluid.solute = {0}, fluid.drained = {0}, fluid.rho = {rho0}, fluid.p = {0}, fluid.id = {0};
+    fluid.x = {Vec3(0, 1, 0)}, fluid.v = {Vec3::Zero()}, fluid.mass = {mf0}, fluid.sph_mass = {mf0}, fluid.solute = {0}, fluid.drained = {0}, fluid.rho = {rho0}, fluid.p = {0}, fluid.p_divergence = {0}, fluid.id = {0};
     auto totals = [&] {
         Real mass = 0, solute = 0;
         Vec3 momentum = Vec3::Zero();

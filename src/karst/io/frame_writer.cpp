@@ -37,7 +37,10 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         PointSet points{fluid.x, {}};
         points.add_vector("velocity", fluid.v);
         points.add_scalar("density", fluid.rho);
-        points.add_scalar("pressure", fluid.p);
+        // The fluid's pressure: the density solve's plus, with DFSPH, the divergence solve's.
+        std::vector<Real> pressure(fluid.size());
+        for (Index i = 0; i < fluid.size(); ++i) pressure[i] = fluid.p[i] + fluid.p_divergence[i];
+        points.add_scalar("pressure", pressure);
         std::vector<Real> water(fluid.size());  // absorption drains it, dissolution brings grains
         for (Index i = 0; i < fluid.size(); ++i) water[i] = fluid.water(i);
         points.add_scalar("water", water);
@@ -66,11 +69,12 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         }
         write_file_atomically(m_dir / "run.pvd", pvd_bytes(entries));
     }
-    std::string csv = "frame,time,dt,steps,particles,density_error,mipps\n";
+    std::string csv = "frame,time,dt,steps,particles,removed,density_error,mipps,speed_p99,max_speed,kinetic_energy,potential_energy,total_energy\n";
     for (int f = 0; f < frames(); ++f) {
         const FrameLog& r = m_log[f];
-        csv += fmt::format("{},{:.9g},{:.6g},{},{},{:.6g},{:.6g}\n", f, r.time, r.dt, r.steps, r.particles,
-                           r.density_error, r.mipps);
+        csv += fmt::format("{},{:.9g},{:.6g},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g}\n", f, r.time, r.dt, r.steps,
+                           r.particles, r.removed, r.density_error, r.mipps, r.speed_p99, r.max_speed, r.kinetic_energy, r.potential_energy,
+                           r.kinetic_energy + r.potential_energy);
     }
     write_file_atomically(m_dir / "log.csv", csv);
 }

@@ -60,6 +60,7 @@ DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::
             fluid.drained.push_back(0);
             fluid.rho.push_back(law.rest_density);
             fluid.p.push_back(0);
+            fluid.p_divergence.push_back(0);
             fluid.id.push_back(next_id++);
             ++report.fluid_created;
         }

@@ -74,6 +74,7 @@ Scene parse_scene(const std::string& text) {
     s.fluid.surface_tension = f["surface_tension"], s.fluid.adhesion = f["adhesion"];
     s.fluid.wall_friction = f["wall_friction"], s.fluid.sound_speed = f["sound_speed"];
     s.fluid.solute_diffusivity = f["solute_diffusivity"];
+    s.fluid.solver = f["solver"] == "pcisph" ? FluidSettings::Solver::Pcisph : FluidSettings::Solver::Dfsph;
     s.fluid.max_density_error = f["max_density_error"];
     s.fluid.min_iterations = f["min_iterations"], s.fluid.max_iterations = f["max_iterations"];
     if (s.fluid.min_iterations > s.fluid.max_iterations)

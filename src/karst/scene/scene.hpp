@@ -28,6 +28,8 @@ struct FluidSettings {
     Real wall_friction = 0;         ///< sigma_f
     Real sound_speed = 20;          ///< c_s, m/s
     Real solute_diffusivity = 1e-4; ///< D of M18, m^2/s
+    enum class Solver { Dfsph, Pcisph };
+    Solver solver = Solver::Dfsph;  ///< pressure solver
     Real max_density_error = 0.01;  ///< eta_rho
     int min_iterations = 3;
     int max_iterations = 50;

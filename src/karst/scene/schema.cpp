@@ -56,7 +56,7 @@ std::vector<KeySpec> make_schema() {
         optional("/time/fixed_dt", T::Number, "s", positive(1.0),
                  "Fixed time step; absent: adaptive CFL step (M11)."),
 
-        key("/fluid", T::Object, "", any(), json::object(), "Fluid (PCISPH) material and solver."),
+        key("/fluid", T::Object, "", any(), json::object(), "Fluid material and pressure solver."),
         key("/fluid/rest_density", T::Number, "kg/m^3", closed(100, 20000), 1000.0,
             "Rest density rho0."),
         key("/fluid/viscosity", T::Number, "m^2/s", closed(0, 1.0), 1e-6,
@@ -77,12 +77,20 @@ std::vector<KeySpec> make_schema() {
             "Numerical sound speed c_s used by wall friction and artificial viscosity (about 10x the expected speed)."),
         key("/fluid/solute_diffusivity", T::Number, "m^2/s", closed(0, 1), 1e-4,
             "Diffusivity D of the solute among fluid particles (M18; scene-scaled, method.md §8.2)."),
+        key("/fluid/solver", T::Enum, "", any(), "dfsph",
+            "Pressure solver. dfsph: divergence-free SPH (Bender & Koschier 2017), a velocity-level solve "
+            "that keeps dense fluid from compressing further, then the constant-density solve, both "
+            "warm-started from the last step's pressures; pcisph: the paper's predictive-corrective "
+            "solver (method.md §4.3), which starts from zero pressure every step.",
+            {"dfsph", "pcisph"}),
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
-            "PCISPH stops when the maximum clamped density error is below this fraction of rho0."),
+            "The pressure solve stops when the largest predicted compression is below this fraction of "
+            "rho0 (DFSPH: also its divergence solve, per step)."),
         key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
-            "PCISPH minimum predictor-corrector iterations."),
+            "PCISPH minimum predictor-corrector iterations (DFSPH, warm-started, stops as soon as it "
+            "meets the tolerance)."),
         key("/fluid/max_iterations", T::Integer, "", closed(1, 1000), 50,
-            "PCISPH maximum predictor-corrector iterations."),
+            "Maximum iterations of each pressure solve."),
 
         key("/fluid_blocks", T::ObjectArray, "", any(), json::array(),
             "Blocks of fluid sampled on the scene lattice (i + 1/2) dx."),

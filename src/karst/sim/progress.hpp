@@ -3,6 +3,8 @@
 // periodic lines otherwise (logs, CI).
 #include "karst/core/timer.hpp"
 
+#include <string>
+
 namespace karst {
 
 struct ProgressInfo {
@@ -13,6 +15,7 @@ struct ProgressInfo {
     double eta_seconds = 0;          ///< wall-clock seconds left
     long long particles = 0;
     double absorbed_kg = -1;         ///< water soaked into porous solids so far; < 0: no porous solids
+    long long removed = 0;           ///< fluid particles that left the domain so far
 };
 
 class ProgressLine {
@@ -22,6 +25,8 @@ public:
     void update(const ProgressInfo& info, bool force = false);
     /// Ends the line on a terminal.
     void finish();
+    /// Prints a warning on a line of its own (even when quiet).
+    void warn(const std::string& message);
 
 private:
     bool m_quiet, m_tty, m_dirty = false;

@@ -8,6 +8,7 @@
 #include "karst/pfem/fragment_structure.hpp"
 #include "karst/porous/porous_points.hpp"
 #include "karst/scene/scene_error.hpp"
+#include "karst/sim/energy.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
 #include "karst/sim/run_poroelastic.hpp"
@@ -112,7 +113,27 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
     FrameWriter out(result.out_dir, scene.output);
     out.write_boundary(model.walls);
-    auto write_frame = [&](const FrameLog& log) {
+    // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the energy
+    // released so far is energy the numerics made; the run says so once.
+    EnergyAccount energy(mechanical_energy(model, state));
+    ProgressLine progress(opt.quiet);
+    bool energy_warned = false, removed_warned = false;
+    auto write_frame = [&](FrameLog log) {
+        const Energy e = mechanical_energy(model, state);
+        log.kinetic_energy = e.kinetic, log.potential_energy = e.potential, log.removed = state.removed;
+        std::tie(log.speed_p99, log.max_speed) = fluid_speed_p99_and_max(state.fluid);
+        energy.add(e);
+        if (!energy_warned && energy.gained_more_than(0.05)) {
+            energy_warned = true;
+            progress.warn(fmt::format("t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the {:.3g} J "
+                                      "released so far (log.csv has the account); try a smaller /time/cfl or dt_max",
+                                      state.time, energy.largest_gain(), 100 * energy.worst_ratio(), energy.released()));
+        }
+        if (!removed_warned && state.removed > 0) {
+            removed_warned = true;
+            progress.warn(fmt::format("t = {:.4g} s: fluid left the domain: {} particles ({:.3g} kg) so far; stats.json "
+                                      "counts.removed has the total", state.time, state.removed, state.removed * model.particle_mass));
+        }
         PointSet porous_points;
         if (porous) porous_points = porous_frame(model, state);
         MeshFrame mesh;
@@ -131,7 +152,6 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
 
     const MassTotals initial = mass_totals(state);
     StepProfile profile;
-    ProgressLine progress(opt.quiet);
     Real max_density_error = 0, frame_density_error = 0;
     double particle_steps = 0, frame_particle_steps = 0, frame_step_seconds = 0;
     Stopwatch stepping;
@@ -153,6 +173,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             {"scene", scene.name},
             {"counts", {{"fluid", state.fluid.size()}, {"boundary", model.walls.size()}, {"porous", state.porous.size()},
                         {"elements", structures ? structures->elements() : 0}, {"fragments", live_fragments(state)}, {"removed", state.removed},
+                        {"pushed_back", state.pushed_back},
                         {"porous_removed", state.porous.removed}, {"dissolved", state.porous.dissolved},
                         {"fluid_drained", state.porous.fluid_deleted}}},
             {"steps", state.steps},
@@ -168,6 +189,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
             {"biot", biot_stats(pfem)},
             {"max_density_error", max_density_error},
+            {"energy", {{"released", energy.released()}, {"largest_gain", energy.largest_gain()},
+                        {"largest_rise_over_start", energy.largest_rise_over_start()}}},
             {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
             {"threads", ThreadLimit::active_threads()},
             {"version", KARST_VERSION},
@@ -213,7 +236,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             const double rate = state.time / std::max(elapsed, 1e-9);
             progress.update({out.frames() - 1, state.time, end, state.steps / std::max(elapsed, 1e-9),
                              particle_steps / std::max(elapsed, 1e-9) / 1e6, (end - state.time) / std::max(rate, 1e-12),
-                             state.fluid.size(), porous ? state.porous.absorbed : -1.0});
+                             state.fluid.size(), porous ? state.porous.absorbed : -1.0, state.removed});
         }
     } catch (const WatchdogError& e) {
         progress.finish();

@@ -7,6 +7,7 @@
 #include "karst/rigid/fragment.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -28,7 +29,11 @@ struct FluidParticles {
     /// kg: its water is m - m_sol - drained (porous/drained_fluid.hpp says why).
     std::vector<Real> drained;
     std::vector<Real> rho;        ///< (n) density of the last step (M7), kg/m^3
-    std::vector<Real> p;          ///< (n) PCISPH pressure of the last step, Pa
+    std::vector<Real> p;          ///< (n) pressure of the last step's density solve, Pa
+    /// (n) pressure of the last step's DFSPH divergence solve (a velocity-level pressure whose
+    /// impulse dt a keeps dense fluid from compressing), Pa; 0 with PCISPH. It warm-starts the
+    /// next divergence solve. The fluid's pressure is p + p_divergence (frames write the sum).
+    std::vector<Real> p_divergence;
     std::vector<std::int64_t> id; ///< (n) stable particle id (export only)
     Index size() const { return Index(x.size()); }
     /// The water particle i holds: m - m_sol - drained, kg.
@@ -48,7 +53,10 @@ struct FluidScratch {
     std::vector<Vec3> a_pressure;   ///< (n) pressure acceleration, m/s^2
     std::vector<Vec3> normal;       ///< (n) Akinci 2013 surface normal, dimensionless
     std::vector<Vec3> x_pred;       ///< (n) PCISPH predicted position, m
-    std::vector<Real> rho_err;      ///< (n) clamped predicted density error, kg/m^3
+    std::vector<Real> rho_err;      ///< (n) predicted density error, kg/m^3
+    std::vector<Vec3> v_pred;       ///< (n) DFSPH predicted velocity, m/s
+    std::vector<Vec3> a_divergence; ///< (n) DFSPH divergence-solve acceleration, m/s^2
+    std::vector<Real> diagonal;     ///< (n) DFSPH -d rho*_i / d p_i, kg/m^3 per Pa
     std::vector<Real> delta;        ///< (n) PCISPH scaling factor delta_i, Pa m^3/kg
     std::vector<Real> pair_coefficient;  ///< per fluid pair (list layout): m_j / rho0^2 dW/dr / r
     std::vector<Real> wall_coefficient;  ///< per wall pair: Psi_k / rho0^2 dW/dr / r
@@ -97,7 +105,11 @@ struct State {
     Index steps = 0;
     Real dt = 0;                  ///< last step, s
     Real a_max = 0;               ///< largest acceleration of the last step, m/s^2
+    /// Upper bound on the next step set by the pressure solve's convergence, s (infinite until a
+    /// solve fails to converge; sph/integrate.hpp).
+    Real dt_solver_limit = std::numeric_limits<Real>::infinity();
     Index removed = 0;            ///< particles that left the domain
+    Index pushed_back = 0;        ///< fluid particles put back inside a wall they crossed (sph/integrate.hpp)
     std::int64_t next_id = 0;
 };
 

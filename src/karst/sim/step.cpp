@@ -108,9 +108,16 @@ StepReport step(const Model& model, State& state, Real dt, StepProfile& profile,
     timed(profile, Stage::NonPressureForces, [&] { compute_non_pressure_forces(model, state); });
     check_vectors(state.scratch.a_other, id, Stage::NonPressureForces, t, "acceleration");
 
-    // 4. PCISPH predict-correct loop with walls and porous particles as boundary (§4.3, M8).
-    const PcisphReport pcisph = timed(profile, Stage::PressureSolve, [&] { return solve_pressure_pcisph(model, state, dt); });
+    // 4. Pressure solve with walls and porous particles as boundary: DFSPH (divergence, then
+    //    constant density; sph/dfsph.hpp) or the paper's PCISPH loop (§4.3, M8). A solve that did
+    //    not converge shortens the next step.
+    const PressureSolveReport pressure = timed(profile, Stage::PressureSolve, [&] {
+        return model.scene.fluid.solver == FluidSettings::Solver::Dfsph ? solve_pressure_dfsph(model, state, dt)
+                                                                        : solve_pressure_pcisph(model, state, dt);
+    });
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
+    update_solver_time_step_limit(state, dt, pressure.max_density_error <= model.scene.fluid.max_density_error,
+                                  model.scene.time.dt_max);
 
     if (porous) {
         // 4b. The fluid's last pressure, friction and adhesion act back on the porous particles.
@@ -149,7 +156,7 @@ StepReport step(const Model& model, State& state, Real dt, StepProfile& profile,
     state.time = t + dt;
     state.dt = dt;
     ++state.steps;
-    return {dt, pcisph.iterations, pcisph.max_density_error};
+    return {dt, pressure.iterations, pressure.divergence_iterations, pressure.max_density_error};
 }
 
 }  // namespace karst

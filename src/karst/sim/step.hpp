@@ -8,6 +8,7 @@ namespace karst {
 struct StepReport {
     Real dt = 0;                 ///< s
     int pressure_iterations = 0;
+    int divergence_iterations = 0;  ///< DFSPH only
     Real max_density_error = 0;  ///< fraction of rho0
 };
 

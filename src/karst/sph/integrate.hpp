@@ -4,7 +4,8 @@
 
 namespace karst {
 
-/// Stage (method.md §4.4): symplectic Euler v += dt (a_other + a_p), x += dt v; then removes the
+/// Stage (method.md §4.4): symplectic Euler v += dt (a_other + a_p), x += dt v; a particle that
+/// crossed a wall's surface is put back inside it (counted in state.pushed_back); then removes the
 /// particles that left the domain (counted in state.removed) and those drained into porous
 /// solids (mass 0). Returns the largest non-pressure acceleration (m/s^2), for the next step's
 /// M11 bound.
@@ -18,8 +19,17 @@ namespace karst {
 /// velocity CFL.
 Real integrate_fluid(const Model& model, State& state, Real dt);
 
+/// [D] The pressure solve's own bound on the step: a solve that ended at its iteration cap
+/// halves the next step, and each converged one lets the bound grow by 10 %. Why: the solve
+/// starts from zero pressure and relaxes it over the neighbourhoods, so how much a step may
+/// compress the fluid (about g dt^2 per layer, summed down a column) is what it must undo in its
+/// iterations; an unconverged solve leaves that compression, and the next impact throws it back
+/// out (a 1 m column at dx 0.01 fell through its own unconverged support within 0.05 s).
+void update_solver_time_step_limit(State& state, Real dt, bool converged, Real dt_max);
+
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max)) clamped to [dt_min, dt_max], or the
-/// scene's fixed step. v_max is the largest fluid or porous speed now; a_max that of the last step.
+/// scene's fixed step. v_max is the largest fluid or porous speed now; a_max that of the last step;
+/// also at most the pressure solve's bound (update_solver_time_step_limit).
 Real cfl_time_step(const Model& model, const State& state);
 
 }  // namespace karst

@@ -1,13 +1,10 @@
 #pragma once
 #include "karst/sim/model.hpp"
+#include "karst/sph/dfsph.hpp"
 #include "karst/sim/state.hpp"
 
 namespace karst {
 
-struct PcisphReport {
-    int iterations = 0;
-    Real max_density_error = 0;  ///< max_i max(rho*_i - rho0, 0) / rho0 of the last prediction
-};
 
 /// Stage (method.md §4.3, Solenthaler & Pajarola 2009): the predict-correct loop. Starting from
 /// p = 0 it predicts x* with the non-pressure and pressure accelerations, predicts rho* (M7) at
@@ -15,6 +12,6 @@ struct PcisphReport {
 /// recomputes the pressure acceleration (walls with mirrored pressure), while
 /// (it < it_min or max_i max(rho*_i - rho0, 0) > eta_rho rho0) and it < it_max.
 /// Writes state.fluid.p (Pa) and scratch.a_pressure (m/s^2).
-PcisphReport solve_pressure_pcisph(const Model& model, State& state, Real dt);
+PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real dt);
 
 }  // namespace karst

@@ -1,0 +1,41 @@
+#include "karst/sim/energy.hpp"
+
+#include "karst/core/parallel.hpp"
+
+#include <algorithm>
+
+namespace karst {
+
+Energy mechanical_energy(const Model& model, const State& state) {
+    const Vec3 g = model.scene.gravity;
+    const FluidParticles& f = state.fluid;
+    const PorousParticles& p = state.porous.particles;
+    Energy e;
+    e.kinetic = deterministic_sum(f.size(), Real(0), [&](Index i) { return 0.5 * f.mass[i] * f.v[i].squaredNorm(); });
+    e.potential = deterministic_sum(f.size(), Real(0), [&](Index i) { return -f.mass[i] * g.dot(f.x[i]); });
+    e.kinetic += deterministic_sum(p.size(), Real(0), [&](Index i) {
+        return 0.5 * (p.solid_mass[i] + p.absorbed_mass[i]) * p.v[i].squaredNorm();
+    });
+    e.potential += deterministic_sum(p.size(), Real(0), [&](Index i) { return -(p.solid_mass[i] + p.absorbed_mass[i]) * g.dot(p.x[i]); });
+    return e;
+}
+
+std::pair<Real, Real> fluid_speed_p99_and_max(const FluidParticles& f) {
+    if (f.size() == 0) return {0, 0};
+    std::vector<Real> speed(f.size());
+    for (Index i = 0; i < f.size(); ++i) speed[i] = f.v[i].norm();
+    const auto p99 = speed.begin() + std::min<Index>(f.size() - 1, Index(0.99 * f.size()));
+    std::nth_element(speed.begin(), p99, speed.end());
+    const Real fast = *p99;
+    return {fast, *std::max_element(p99, speed.end())};
+}
+
+void EnergyAccount::add(const Energy& e) {
+    m_released = std::max(m_released, m_start.kinetic + m_start.potential - e.potential);
+    m_largest_gain = std::max(m_largest_gain, e.total() - m_lowest);
+    m_largest_rise = std::max(m_largest_rise, e.total() - m_start.total());
+    if (m_released > 0) m_worst_ratio = std::max(m_worst_ratio, (e.total() - m_lowest) / m_released);
+    m_lowest = std::min(m_lowest, e.total());
+}
+
+}  // namespace karst

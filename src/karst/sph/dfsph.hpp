@@ -1,0 +1,24 @@
+#pragma once
+#include "karst/sim/model.hpp"
+#include "karst/sim/state.hpp"
+
+namespace karst {
+
+struct PressureSolveReport {
+    int iterations = 0;             ///< density-solve iterations (PCISPH: predictor-corrector)
+    int divergence_iterations = 0;  ///< DFSPH divergence-solve iterations; 0 for PCISPH
+    Real max_density_error = 0;     ///< largest predicted compression max_i (rho*_i - rho0) / rho0 at the end
+};
+
+/// Stage (method.md §4.3, replaced): divergence-free SPH after Bender & Koschier 2017, with the
+/// Akinci boundary of walls and porous particles. Two solves on the velocities, each a relaxed
+/// Jacobi iteration on the pressures p_i >= 0 of the linearised density
+///   rho*_i = rho_i + dt sum_j m_j (v*_i - v*_j).grad W_ij + dt sum_k Psi_k (v*_i - v_k).grad W_ik:
+/// 1. divergence: v* = v + dt a^p(p_div), until no particle at or above rho0 is compressed
+///    further (rho*_i <= max(rho_i, rho0));
+/// 2. constant density: v* = v + dt (a_div + a_other + a^p(p)), until rho*_i <= rho0 (1 + eta).
+/// The divergence solve starts from the last step's p_div, the density solve from p = 0. Writes state.fluid.p and p_divergence (Pa) and
+/// scratch.a_pressure = a_div + a^p(p) (m/s^2).
+PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real dt);
+
+}  // namespace karst

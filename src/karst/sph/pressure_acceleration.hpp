@@ -1,0 +1,59 @@
+#pragma once
+// The pressure acceleration shared by both pressure solvers (PCISPH, DFSPH):
+//   a_i^p = -sum_j m_j (p_i + p_j) / rho0^2 grad W_ij - sum_k Psi_k (p_i + p_ik) / rho0^2 grad W_ik
+// over fluid neighbours j and boundary neighbours k (walls and porous particles, §4.3), with the
+// boundary pressure p_ik extrapolated hydrostatically (coupling/boundary_pair.hpp) or mirrored.
+#include "karst/coupling/boundary_pair.hpp"
+#include "karst/sim/model.hpp"
+#include "karst/sim/state.hpp"
+
+namespace karst {
+
+/// Per pair, the parts of a_i^p that stay fixed through a step's iterations: m_j / rho0^2 dW/dr / r
+/// (fluid), Psi_k / rho0^2 dW/dr / r and -rho0 g.x_ik (walls, porous). Computing them once per
+/// step saves a square root, a division and the kernel in every iteration.
+void pressure_pair_coefficients(const Model& model, State& state);
+
+/// How the pressure of a boundary particle is read in a_i^p.
+enum class BoundaryPressure {
+    Hydrostatic,  ///< p_ik = max(p_i - rho0 g.x_ik, 0): the density solve (pcisph.cpp says why)
+    Mirrored,     ///< p_ik = p_i: a velocity-level (divergence) pressure, which has no weight
+};
+
+/// a_i^p of fluid particle i for the pressures p (Pa), from the coefficients of this step; per
+/// unit rho0 V, scaled to act on the true mass. Boundary terms vanish where p_i = 0.
+inline Vec3 pressure_acceleration(const Model& model, const State& state, const std::vector<Real>& p, Index i,
+                                  BoundaryPressure boundary) {
+    const FluidParticles& f = state.fluid;
+    const FluidScratch& s = state.scratch;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
+    const Vec3 xi = f.x[i];
+    const Real pi = p[i];
+    Vec3 a = Vec3::Zero();
+    const Real* cf = s.pair_coefficient.data() + i * cap_f;
+    int k = 0;
+    s.fluid_fluid.for_each(i, [&](Index j) { a -= ((pi + p[j]) * cf[k++]) * (xi - f.x[j]); });
+    if (pi != 0) {
+        const bool hydrostatic = boundary == BoundaryPressure::Hydrostatic;
+        const Real* cw = s.wall_coefficient.data() + i * cap_w;
+        const Real* hw = s.wall_hydrostatic.data() + i * cap_w;
+        k = 0;
+        s.fluid_wall.for_each(i, [&](Index w) {
+            a -= boundary_pressure_term(pi, cw[k], hydrostatic ? hw[k] : 0, xi - model.walls.x[w]);
+            ++k;
+        });
+        // Porous particles are boundary particles like walls (§4.3); their reaction is the same
+        // term, summed on the fragment side (coupling/fluid_reactions.cpp).
+        const std::vector<Vec3>& porous_x = state.porous.particles.x;
+        const Real* cp = s.porous_coefficient.data() + i * cap_p;
+        const Real* hp = s.porous_hydrostatic.data() + i * cap_p;
+        k = 0;
+        s.fluid_porous.for_each(i, [&](Index w) {
+            a -= boundary_pressure_term(pi, cp[k], hydrostatic ? hp[k] : 0, xi - porous_x[w]);
+            ++k;
+        });
+    }
+    return a * (f.sph_mass[i] / f.mass[i]);  // a force per unit rho0 V acting on the true mass
+}
+
+}  // namespace karst
