@@ -76,6 +76,7 @@ Scene parse_scene(const std::string& text) {
     s.fluid.solute_diffusivity = f["solute_diffusivity"];
     s.fluid.solver = f["solver"] == "pcisph" ? FluidSettings::Solver::Pcisph : FluidSettings::Solver::Dfsph;
     s.fluid.max_density_error = f["max_density_error"];
+    s.fluid.max_divergence_error = f["max_divergence_error"];
     s.fluid.min_iterations = f["min_iterations"], s.fluid.max_iterations = f["max_iterations"];
     if (s.fluid.min_iterations > s.fluid.max_iterations)
         throw SceneError("/fluid/min_iterations", fmt::format("at most max_iterations = {}", s.fluid.max_iterations),

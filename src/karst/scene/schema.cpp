@@ -80,12 +80,17 @@ std::vector<KeySpec> make_schema() {
         key("/fluid/solver", T::Enum, "", any(), "dfsph",
             "Pressure solver. dfsph: divergence-free SPH (Bender & Koschier 2017), a velocity-level solve "
             "that keeps dense fluid from compressing further, then the constant-density solve, both "
-            "warm-started from the last step's pressures; pcisph: the paper's predictive-corrective "
-            "solver (method.md §4.3), which starts from zero pressure every step.",
+            "with the Akinci boundary of walls and porous particles; pcisph: the paper's "
+            "predictive-corrective solver (method.md §4.3), kept for comparison: it can gain energy in "
+            "impacts.",
             {"dfsph", "pcisph"}),
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
             "The pressure solve stops when the largest predicted compression is below this fraction of "
-            "rho0 (DFSPH: also its divergence solve, per step)."),
+            "rho0."),
+        key("/fluid/max_divergence_error", T::Number, "", closed(1e-6, 0.1), 0.001,
+            "DFSPH's divergence solve stops when no particle at or above rho0 would compress by more "
+            "than this fraction of rho0 over the step. Tighter than max_density_error: a looser "
+            "divergence solve lets a resting column sink through its own support."),
         key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
             "PCISPH minimum predictor-corrector iterations (DFSPH, warm-started, stops as soon as it "
             "meets the tolerance)."),

@@ -227,7 +227,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
 
             const bool frame_due = state.time >= frame_time - 1e-9 * dt;
             if (frame_due) {
-                write_frame({state.time, dt, state.steps, state.fluid.size(), frame_density_error,
+                write_frame({state.time, report.dt, state.steps, state.fluid.size(), frame_density_error,
                              frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
                 ++next_frame;
                 frame_density_error = 0, frame_particle_steps = 0, frame_step_seconds = 0;

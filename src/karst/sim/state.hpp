@@ -31,8 +31,8 @@ struct FluidParticles {
     std::vector<Real> rho;        ///< (n) density of the last step (M7), kg/m^3
     std::vector<Real> p;          ///< (n) pressure of the last step's density solve, Pa
     /// (n) pressure of the last step's DFSPH divergence solve (a velocity-level pressure whose
-    /// impulse dt a keeps dense fluid from compressing), Pa; 0 with PCISPH. It warm-starts the
-    /// next divergence solve. The fluid's pressure is p + p_divergence (frames write the sum).
+    /// impulse dt a keeps dense fluid from compressing), Pa; 0 with PCISPH. The fluid's pressure
+    /// is p + p_divergence (frames write the sum; the porous reactions take both).
     std::vector<Real> p_divergence;
     std::vector<std::int64_t> id; ///< (n) stable particle id (export only)
     Index size() const { return Index(x.size()); }

@@ -22,6 +22,10 @@
 namespace karst {
 
 namespace {
+
+/// How often a step whose pressure solve did not converge is retried at half its length.
+constexpr int k_max_step_halvings = 4;
+
 template <class F>
 auto timed(StepProfile& profile, Stage stage, const F& f) {
     Stopwatch watch;
@@ -82,10 +86,11 @@ void dissolve_particles(const Model& model, State& state) {
 
 }  // namespace
 
-StepReport step(const Model& model, State& state, Real dt, StepProfile& profile, FragmentStructures* structures) {
+StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& profile, FragmentStructures* structures) {
     const Real t = state.time;
     const auto& id = state.fluid.id;
     const bool porous = state.porous.size() > 0;
+    Real dt = dt_wanted;
 
     // 1. Neighbour search (and periodic Morton reordering of the fluid), porous pairs after.
     timed(profile, Stage::Neighbours, [&] {
@@ -100,24 +105,33 @@ StepReport step(const Model& model, State& state, Real dt, StepProfile& profile,
     });
     check_scalars(state.fluid.rho, id, Stage::Density, t, "density");
 
-    // 2b. Solute diffusion among fluid particles (M18), on this step's densities and lists.
-    timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });
-    check_scalars(state.fluid.solute, id, Stage::SoluteDiffusion, t, "solute mass");
-
     // 3. Gravity, viscosity, surface tension, adhesion, boundary friction (§4.2).
     timed(profile, Stage::NonPressureForces, [&] { compute_non_pressure_forces(model, state); });
     check_vectors(state.scratch.a_other, id, Stage::NonPressureForces, t, "acceleration");
 
     // 4. Pressure solve with walls and porous particles as boundary: DFSPH (divergence, then
-    //    constant density; sph/dfsph.hpp) or the paper's PCISPH loop (§4.3, M8). A solve that did
-    //    not converge shortens the next step.
-    const PressureSolveReport pressure = timed(profile, Stage::PressureSolve, [&] {
-        return model.scene.fluid.solver == FluidSettings::Solver::Dfsph ? solve_pressure_dfsph(model, state, dt)
-                                                                        : solve_pressure_pcisph(model, state, dt);
+    //    constant density; sph/dfsph.hpp) or the paper's PCISPH loop (§4.3, M8). A solve that
+    //    ends at its iteration cap is repeated with half the step (sph/integrate.hpp says why),
+    //    unless the step is fixed; nothing has moved yet, so only the step length changes.
+    const FluidSettings& fs = model.scene.fluid;
+    PressureSolveReport pressure;
+    bool converged = false;
+    timed(profile, Stage::PressureSolve, [&] {
+        for (int halvings = 0;; ++halvings) {
+            pressure = fs.solver == FluidSettings::Solver::Dfsph ? solve_pressure_dfsph(model, state, dt)
+                                                                 : solve_pressure_pcisph(model, state, dt);
+            converged = pressure.max_density_error <= fs.max_density_error;
+            if (converged || model.scene.time.fixed_dt || halvings == k_max_step_halvings || dt / 2 < model.scene.time.dt_min)
+                break;
+            dt /= 2;
+        }
     });
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
-    update_solver_time_step_limit(state, dt, pressure.max_density_error <= model.scene.fluid.max_density_error,
-                                  model.scene.time.dt_max);
+    update_solver_time_step_limit(state, dt, converged, model.scene.time.dt_max);
+
+    // 4a. Solute diffusion among fluid particles (M18), on this step's densities and lists.
+    timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });
+    check_scalars(state.fluid.solute, id, Stage::SoluteDiffusion, t, "solute mass");
 
     if (porous) {
         // 4b. The fluid's last pressure, friction and adhesion act back on the porous particles.

@@ -14,7 +14,8 @@ struct StepReport {
 
 class FragmentStructures;
 
-/// Advances the state by one step of length dt (method.md §3). `structures`, when given, runs
+/// Advances the state by one step of length dt (method.md §3), or a half, quarter ... of it when
+/// the pressure solve does not converge (StepReport::dt says which). `structures`, when given, runs
 /// the Biot step of the anchored fragments (§5). Throws WatchdogError if a stage produces a NaN
 /// or a runaway speed.
 StepReport step(const Model& model, State& state, Real dt, StepProfile& profile, FragmentStructures* structures = nullptr);

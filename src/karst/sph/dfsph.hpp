@@ -15,9 +15,11 @@ struct PressureSolveReport {
 /// Jacobi iteration on the pressures p_i >= 0 of the linearised density
 ///   rho*_i = rho_i + dt sum_j m_j (v*_i - v*_j).grad W_ij + dt sum_k Psi_k (v*_i - v_k).grad W_ik:
 /// 1. divergence: v* = v + dt a^p(p_div), until no particle at or above rho0 is compressed
-///    further (rho*_i <= max(rho_i, rho0));
+///    further (rho*_i <= max(rho_i, rho0) within /fluid/max_divergence_error);
 /// 2. constant density: v* = v + dt (a_div + a_other + a^p(p)), until rho*_i <= rho0 (1 + eta).
-/// The divergence solve starts from the last step's p_div, the density solve from p = 0. Writes state.fluid.p and p_divergence (Pa) and
+/// The stopping test reads the complementarity residual (compression, or over-pressure that
+/// p_i could give back). The divergence solve starts from zero, the density solve from half the
+/// last step's pressure where the fluid would compress (dfsph.cpp says why). Writes state.fluid.p and p_divergence (Pa) and
 /// scratch.a_pressure = a_div + a^p(p) (m/s^2).
 PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real dt);
 
