@@ -17,14 +17,12 @@ namespace {
 // water, q = rho0 g H = 981 Pa. Its sides touch the tank walls, so they are anchored with its
 // base; the top is free. (On a 0.2 m tank the side walls carried 6 % of the water's weight
 // through the fluid along their foot.)
-/// `poroelastic` adds keys to /poroelastic. PCISPH, whose load is steady by the last calls: the
-/// particles follow u one call behind, and with DFSPH the top u still moved 5 % between the last
-/// two calls (3 % allowed below).
+/// `poroelastic` adds keys to /poroelastic.
 std::string loaded_block_scene(Real youngs_modulus, const std::string& poroelastic = "") {
     return R"({
   "name": "loaded_block", "particle_spacing": 0.02,
   "time": { "fixed_dt": 0.002 },
-  "fluid": { "artificial_viscosity": 0.02, "solver": "pcisph" },
+  "fluid": { "artificial_viscosity": 0.02 },
   "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0.06], "max": [0.4, 0.4, 0.16] } } ],
   "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.4] } } ],
   "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.06] },

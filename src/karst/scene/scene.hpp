@@ -31,7 +31,7 @@ struct FluidSettings {
     enum class Solver { Dfsph, Pcisph };
     Solver solver = Solver::Dfsph;  ///< pressure solver
     Real max_density_error = 0.01;  ///< eta_rho
-    Real max_divergence_error = 0.001;  ///< DFSPH divergence solve: largest dt Drho/Dt / rho0
+    Real max_divergence_error = 0.01;   ///< DFSPH divergence solve: largest dt Drho/Dt / rho0
     int min_iterations = 3;
     int max_iterations = 50;
 };

@@ -87,10 +87,9 @@ std::vector<KeySpec> make_schema() {
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
             "The pressure solve stops when the largest predicted compression is below this fraction of "
             "rho0."),
-        key("/fluid/max_divergence_error", T::Number, "", closed(1e-6, 0.1), 0.001,
+        key("/fluid/max_divergence_error", T::Number, "", closed(1e-6, 0.1), 0.01,
             "DFSPH's divergence solve stops when no particle at or above rho0 would compress by more "
-            "than this fraction of rho0 over the step. Tighter than max_density_error: a looser "
-            "divergence solve lets a resting column sink through its own support."),
+            "than this fraction of rho0 over the step."),
         key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
             "PCISPH minimum predictor-corrector iterations (DFSPH, warm-started, stops as soon as it "
             "meets the tolerance)."),

@@ -19,8 +19,9 @@ namespace karst {
 /// velocity CFL.
 Real integrate_fluid(const Model& model, State& state, Real dt);
 
-/// [D] The pressure solve's own bound on the step: a solve that ended at its iteration cap
-/// halves the next step, and each converged one lets the bound grow by 10 %. Why: the solve
+/// [D] The pressure solve's own bound on the step: a solve that left over 1 % compression
+/// (sim/step.cpp) bounds the next steps by the halved step that did converge, and each converged
+/// step lets the bound grow by 10 %. Why: the solve
 /// starts from zero pressure and relaxes it over the neighbourhoods, so how much a step may
 /// compress the fluid (about g dt^2 per layer, summed down a column) is what it must undo in its
 /// iterations; an unconverged solve leaves that compression, and the next impact throws it back

@@ -9,6 +9,9 @@ namespace karst {
 
 namespace {
 
+/// Under-relaxation of M8's delta, as in IISPH's relaxed Jacobi (the DFSPH solve uses the same).
+constexpr Real k_relaxation = 0.5;
+
 /// a_i^p at the current pressures (sph/pressure_acceleration.hpp), then the prediction
 /// x*_i = x_i + dt (v_i + dt (a_other + a_p)) for the next density pass.
 ///
@@ -39,6 +42,9 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 /// neighbours add; at wall corners |sum_k Psi_k grad W_ik|^2 is several times the prototype's
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
 /// diverges. Capping keeps the prototype everywhere it is stable (the interior, free surface).
+/// Then relaxed by k_relaxation [D]: M8 assumes the neighbours keep their pressure while a
+/// particle's own rises, so the full delta over-shoots once they respond too, and in impacts
+/// the loop threw water out with energy it never had (issue 11's note has the figures).
 void compute_delta(const Model& model, const State& state, Real dt, std::vector<Real>& delta) {
     const PorousParticles& porous = state.porous.particles;
     const std::vector<Real>& psi = state.porous_scratch.psi;
@@ -59,7 +65,7 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
         s.fluid_wall.for_each(i, [&](Index k) { sum_grad += model.walls.psi[k] * W.gradient(f.x[i] - model.walls.x[k]); });
         s.fluid_porous.for_each(i, [&](Index k) { sum_grad += psi[k] * W.gradient(f.x[i] - porous.x[k]); });
         const Real denominator = sum_grad.squaredNorm() + sum_sq;
-        delta[i] = denominator > 0 ? std::min(prototype, scale / denominator) : prototype;
+        delta[i] = k_relaxation * (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
     });
 }
 
@@ -96,9 +102,11 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
             s.fluid_fluid.for_each(i, [&](Index j) { rho += f.sph_mass[j] * W.w((xi - s.x_pred[j]).norm()); });
             s.fluid_wall.for_each(i, [&](Index k) { rho += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm()); });
             s.fluid_porous.for_each(i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
-            const Real err = std::max(rho - rho0, Real(0));
-            s.rho_err[i] = err;
-            f.p[i] += s.delta[i] * err;
+            // Signed error, p clamped at 0 (method.md §4.3); the stopping test reads the
+            // compression, or the over-pressure p_i could give back where the fluid expands.
+            const Real e = rho - rho0;
+            s.rho_err[i] = e > 0 ? e : std::min(-e, f.p[i] / s.delta[i]);
+            f.p[i] = std::max(f.p[i] + s.delta[i] * e, Real(0));
         });
         report.max_density_error = parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / rho0;
         pressure_acceleration_and_prediction(model, state, dt);
