@@ -132,7 +132,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         }
     });
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
-    update_solver_time_step_limit(state, dt, converged, model.scene.time.dt_max);
+    update_solver_time_step_limit(state, dt, dt < dt_wanted, converged, model.scene.time.dt_max);
 
     // 4a. Solute diffusion among fluid particles (M18), on this step's densities and lists.
     timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });

@@ -71,9 +71,10 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
     return a_max;
 }
 
-void update_solver_time_step_limit(State& state, Real dt, bool converged, Real dt_max) {
-    state.dt_solver_limit = converged ? (state.dt_solver_limit < dt_max ? 1.1 * state.dt_solver_limit : state.dt_solver_limit)
-                                      : 0.5 * dt;
+void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged, Real dt_max) {
+    if (!converged) state.dt_solver_limit = 0.5 * dt;
+    else if (shortened) state.dt_solver_limit = dt;
+    else if (state.dt_solver_limit < dt_max) state.dt_solver_limit *= 1.1;
 }
 
 Real cfl_time_step(const Model& model, const State& state) {

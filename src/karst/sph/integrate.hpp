@@ -20,13 +20,14 @@ namespace karst {
 Real integrate_fluid(const Model& model, State& state, Real dt);
 
 /// [D] The pressure solve's own bound on the step: a solve that left over 1 % compression
-/// (sim/step.cpp) bounds the next steps by the halved step that did converge, and each converged
-/// step lets the bound grow by 10 %. Why: the solve
-/// starts from zero pressure and relaxes it over the neighbourhoods, so how much a step may
-/// compress the fluid (about g dt^2 per layer, summed down a column) is what it must undo in its
-/// iterations; an unconverged solve leaves that compression, and the next impact throws it back
-/// out (a 1 m column at dx 0.01 fell through its own unconverged support within 0.05 s).
-void update_solver_time_step_limit(State& state, Real dt, bool converged, Real dt_max);
+/// (sim/step.cpp) even when halved bounds the next step by half of it; a step that had to be
+/// halved to converge bounds the next ones by its length; each step that converged at once lets
+/// the bound grow by 10 %. `dt` is the step taken, `shortened` whether it was cut to converge.
+/// Why: the Jacobi-type solves relax the pressure over the neighbourhoods, so what a step's
+/// motion compresses (about g dt^2 per layer, summed down a column) is what they must undo in
+/// their iterations; an unconverged solve leaves that compression, and the next impact throws it
+/// back out.
+void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged, Real dt_max);
 
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max)) clamped to [dt_min, dt_max], or the
 /// scene's fixed step. v_max is the largest fluid or porous speed now; a_max that of the last step;
