@@ -9,11 +9,6 @@ namespace karst {
 
 namespace {
 
-/// Jacobi relaxation of the pressure update, as in IISPH (Ihmsen et al. 2014): the diagonal
-/// alone over-estimates how far a particle's own pressure moves its density once its neighbours
-/// respond too.
-constexpr Real k_relaxation = 0.5;
-
 /// -d rho*_i / d p_i = dt^2 / rho0^2 (g_i.G_i + m_i sum_j m_j |grad W_ij|^2), with
 /// g_i = sum_j m_j grad W_ij + sum_k Psi_k grad W_ik and G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik
 /// (a boundary neighbour carries p_i + p_ik, both rising with p_i). Fixed for the step.
@@ -99,7 +94,7 @@ SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& 
         ++r.iterations;
         if (r.max_error <= tolerance || r.iterations >= max_iterations) break;
         parallel_for(n, [&](Index i) {
-            if (s.diagonal[i] > 0) p[i] = std::max(p[i] + k_relaxation * s.rho_err[i] / s.diagonal[i], Real(0));
+            if (s.diagonal[i] > 0) p[i] = std::max(p[i] + k_pressure_relaxation * s.rho_err[i] / s.diagonal[i], Real(0));
         });
     }
     return r;

@@ -9,9 +9,6 @@ namespace karst {
 
 namespace {
 
-/// Under-relaxation of M8's delta, as in IISPH's relaxed Jacobi (the DFSPH solve uses the same).
-constexpr Real k_relaxation = 0.5;
-
 /// a_i^p at the current pressures (sph/pressure_acceleration.hpp), then the prediction
 /// x*_i = x_i + dt (v_i + dt (a_other + a_p)) for the next density pass.
 ///
@@ -42,9 +39,7 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 /// neighbours add; at wall corners |sum_k Psi_k grad W_ik|^2 is several times the prototype's
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
 /// diverges. Capping keeps the prototype everywhere it is stable (the interior, free surface).
-/// Then relaxed by k_relaxation [D]: M8 assumes the neighbours keep their pressure while a
-/// particle's own rises, so the full delta over-shoots once they respond too, and in impacts
-/// the loop threw water out with energy it never had (issue 11's note has the figures).
+/// Then under-relaxed by k_pressure_relaxation [D] (sph/pressure_acceleration.hpp says why).
 void compute_delta(const Model& model, const State& state, Real dt, std::vector<Real>& delta) {
     const PorousParticles& porous = state.porous.particles;
     const std::vector<Real>& psi = state.porous_scratch.psi;
@@ -65,7 +60,7 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
         s.fluid_wall.for_each(i, [&](Index k) { sum_grad += model.walls.psi[k] * W.gradient(f.x[i] - model.walls.x[k]); });
         s.fluid_porous.for_each(i, [&](Index k) { sum_grad += psi[k] * W.gradient(f.x[i] - porous.x[k]); });
         const Real denominator = sum_grad.squaredNorm() + sum_sq;
-        delta[i] = k_relaxation * (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
+        delta[i] = k_pressure_relaxation * (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
     });
 }
 

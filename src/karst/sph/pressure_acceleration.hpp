@@ -9,6 +9,12 @@
 
 namespace karst {
 
+/// Under-relaxation of both solvers' Jacobi pressure updates (IISPH's relaxed Jacobi, Ihmsen
+/// et al. 2014): the diagonal alone (M8's delta, DFSPH's -d rho*_i / d p_i) assumes the
+/// neighbours keep their pressure while a particle's own rises, and over-shoots once they
+/// respond too; in impacts the full update threw water out with energy it never had.
+inline constexpr Real k_pressure_relaxation = 0.5;
+
 /// Per pair, the parts of a_i^p that stay fixed through a step's iterations: m_j / rho0^2 dW/dr / r
 /// (fluid), Psi_k / rho0^2 dW/dr / r and -rho0 g.x_ik (walls, porous). Computing them once per
 /// step saves a square root, a division and the kernel in every iteration.
