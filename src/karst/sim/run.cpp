@@ -126,7 +126,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         if (!energy_warned && energy.gained_more_than(0.05)) {
             energy_warned = true;
             progress.warn(fmt::format("t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the {:.3g} J "
-                                      "released so far (log.csv has the account); try a smaller /time/cfl or dt_max",
+                                      "released so far (log.csv has the account)",
                                       state.time, energy.largest_gain(), 100 * energy.worst_ratio(), energy.released()));
         }
         if (!removed_warned && state.removed > 0) {

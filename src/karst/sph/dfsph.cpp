@@ -64,8 +64,8 @@ Real density_change(const Model& model, const State& state, const std::vector<Ve
     return dt * rho0_2 * sum;
 }
 
-/// One relaxed Jacobi solve for p >= 0 with rho*_i(v*) <= target_i (1 + tolerance share):
-/// v*_i = base_i + dt a^p_i(p). Returns iterations and the last largest excess over rho0.
+/// One relaxed Jacobi solve for p >= 0 with rho*_i(v*) <= target_i within tolerance rho0, where
+/// v*_i = base_i + dt a^p_i(p); a_out gets a^p(p). Returns the iterations and the last residual.
 struct SolveResult {
     int iterations = 0;
     Real max_error = 0;
@@ -111,7 +111,6 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     pressure_pair_coefficients(model, state);
     compute_diagonal(model, state, dt);
     s.v_pred.resize(n), s.rho_err.resize(n), s.a_divergence.resize(n), s.a_pressure.resize(n);
-    if (f.p_divergence.size() != size_t(n)) f.p_divergence.assign(n, 0);
 
     PressureSolveReport report;
     // 1. Divergence, from zero: fluid at or above rho0 may not compress further, lighter fluid up
@@ -126,9 +125,9 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     base.resize(n);
     parallel_for(n, [&](Index i) { base[i] = f.v[i] + dt * (s.a_divergence[i] + s.a_other[i]); });
     // Warm start as SPlisHSPlasH's DFSPH does: half the last pressure where the fluid would
-    // compress without it, zero elsewhere. Measured on the hydrostatic test column: the full last
-    // pressure kept it moving (RMS 0.12-0.26 m/s), zero settled it (0.03 m/s) but cannot hold deep
-    // water, whose pressure a Jacobi iteration rebuilds only a layer or two per iteration.
+    // compress without it, zero elsewhere. The full last pressure kept a resting column moving
+    // (the solve accepts it unchanged inside its tolerance band); zero cannot hold deep water,
+    // whose pressure a Jacobi iteration rebuilds only a layer or two per iteration.
     parallel_for(n, [&](Index i) {
         const bool compressed = f.rho[i] + density_change(model, state, base, i, dt) > rho0;
         f.p[i] = compressed ? 0.5 * f.p[i] : 0;
