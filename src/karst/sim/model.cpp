@@ -207,6 +207,31 @@ void set_up_porous_materials(Model& m) {
     m.porous_grid = UniformGrid(m.domain, reach);
 }
 
+/// The Biot problems a scene can pose (method.md §5): a poroelastic-only solid needs pores, and
+/// in a coupled scene only anchored fragments of permeable solids get one, so constraints on
+/// any other solid would be silently ignored.
+void check_biot_setup(const Model& m) {
+    const Scene& scene = m.scene;
+    for (const PorousSolid& s : scene.porous_solids) {
+        if (!m.coupled()) {
+            if (s.material.porosity < k_min_porosity)
+                throw SceneError(s.path + "/material/porosity",
+                                 "a porosity of at least 1e-4 in a poroelastic-only scene (an impermeable solid has no pore pressure)",
+                                 fmt::format("{}", s.material.porosity));
+            continue;
+        }
+        if (s.constraints.empty()) continue;
+        const char* why = !scene.poroelastic.coupled_fragments ? "/poroelastic/coupled_fragments is none"
+                          : !s.anchored                        ? "the solid is free (free fragments move rigidly)"
+                          : s.material.porosity < k_min_porosity ? "the solid is impermeable (porosity below 1e-4)"
+                                                                 : nullptr;
+        if (why)
+            throw SceneError(s.path + "/constraints",
+                             fmt::format("no Biot constraints here: {}, so no Biot problem is solved for this solid", why),
+                             fmt::format("{} constraints", s.constraints.size()));
+    }
+}
+
 }  // namespace
 
 Model build_model(const Scene& scene) {
@@ -243,6 +268,7 @@ Model build_model(const Scene& scene) {
     m.grid = UniformGrid(m.domain, m.h);
     compute_wall_volumes(m, wall_layers);
     set_up_porous_materials(m);
+    check_biot_setup(m);
     return m;
 }
 

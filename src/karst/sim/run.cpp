@@ -58,22 +58,6 @@ Real step_towards(Real dt_cfl, Real now, Real target) {
     return remaining / n;
 }
 
-/// In a coupled scene the Biot step runs on anchored fragments of permeable solids only, so
-/// constraints anywhere else would be silently ignored: refuse them.
-void check_coupled_scene(const Scene& scene) {
-    for (const PorousSolid& s : scene.porous_solids) {
-        if (s.constraints.empty()) continue;
-        const char* why = !scene.poroelastic.coupled_fragments ? "/poroelastic/coupled_fragments is none"
-                          : !s.anchored                        ? "the solid is free (free fragments move rigidly)"
-                          : s.material.porosity < k_min_porosity ? "the solid is impermeable (porosity below 1e-4)"
-                                                                 : nullptr;
-        if (why)
-            throw SceneError(s.path + "/constraints",
-                             fmt::format("no Biot constraints here: {}, so no Biot problem is solved for this solid", why),
-                             fmt::format("{} constraints", s.constraints.size()));
-    }
-}
-
 /// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current
 /// positions (dissolution may have removed particles since the step's search).
 PointSet porous_frame(const Model& model, const State& state) {
@@ -102,7 +86,6 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     Stopwatch wall;
     const Model model = build_model(scene);
     if (!model.porous.empty() && !model.coupled()) return run_poroelastic(model, opt);
-    check_coupled_scene(scene);
     State state = make_initial_state(model);
     const bool porous = state.porous.size() > 0;
     std::optional<FragmentStructures> structures;

@@ -19,11 +19,6 @@ nlohmann::json biot_stats(const PfemTimings& t) {
 }
 
 RunResult run_poroelastic(const Model& model, const RunOptions& options) {
-    for (const PorousSolid& solid : model.scene.porous_solids)
-        if (solid.material.porosity < k_min_porosity)
-            throw SceneError(solid.path + "/material/porosity",
-                             "a porosity of at least 1e-4 in a poroelastic-only scene (an impermeable solid has no pore pressure)",
-                             fmt::format("{}", solid.material.porosity));
     const Scene& scene = model.scene;
     Stopwatch wall;
     RunResult result;
