@@ -11,6 +11,8 @@
 //                    [--amg-flow-unknowns N]
 // --edge sets the block's side in m at spacing 0.1 m (default 4: 70,602 nodes), for the size
 // at which the flow system is better solved by AMG than by CHOLMOD (BiotOptions::amg_flow_unknowns).
+#include "provenance.hpp"
+
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/pfem/biot.hpp"
@@ -119,13 +121,10 @@ int main(int argc, char** argv) {
     fmt::print("    later call, same mesh   {:.3f} s ({} iterations, {} elastic solves; flow set-up {:.3f} s)\n", later_call, second.iterations,
                second.elastic_solves, second.seconds_flow_factorisation);
 
-    const std::filesystem::path dir = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core";
-    std::filesystem::create_directories(dir);
-    const auto file = dir / "bench_pfem_70k.csv";
-    const bool fresh = !std::filesystem::exists(file);
-    std::ofstream csv(file, std::ios::app);
-    if (fresh)
-        csv << "solver,threads,nodes,elements,s_bare_delaunay,s_mesh,s_bare_delaunay_jittered,s_mesh_jittered,s_assembly,s_elastic_factor,s_flow_factor,s_iterations,iterations,s_first_call,s_later_call\n";
+    const auto file = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core" / "bench_pfem_70k.csv";
+    std::ofstream csv = bench::open_results(file, "solver,threads,nodes,elements,s_bare_delaunay,s_mesh,s_bare_delaunay_jittered,s_mesh_jittered,"
+                                                  "s_assembly,s_elastic_factor,s_flow_factor,s_iterations,iterations,s_first_call,s_later_call");
+    csv << bench::provenance_fields(KARST_SOURCE_DIR);
     csv << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f},{:.4f}\n", solvers, ThreadLimit::active_threads(), nodes.size(),
                        q.elements, bare, meshing, bare_jittered, meshing_jittered, solver.seconds_assembly(), solver.seconds_elastic_factorisation(),
                        first.seconds_flow_factorisation, first.seconds_iterations, first.iterations, first_call, later_call);

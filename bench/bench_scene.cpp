@@ -7,9 +7,12 @@
 // bench/results/2core/<scene>.csv.
 //
 //   karst_bench_scene [--scene NAME] [--steps N] [--warmup N] [--threads N] [--solver dfsph|pcisph]
+#include "provenance.hpp"
+
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/scene/scene.hpp"
+#include "karst/pfem/structure_stages.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 #include "karst/sim/step.hpp"
@@ -20,7 +23,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
+#include <limits>
 
 using namespace karst;
 
@@ -43,9 +46,11 @@ int main(int argc, char** argv) {
     const bool dfsph = scene_data.fluid.solver == FluidSettings::Solver::Dfsph;
     const Model model = build_model(scene_data);
     State state = make_initial_state(model);
-    const Real dt = *model.scene.time.fixed_dt;
+    // The step a run takes (the scenes fix it at 1 ms), Biot calls included where the scene has them.
+    auto next_step = [&] { return next_step_length(model, state, std::numeric_limits<Real>::infinity()); };
     StepProfile warm;
-    for (int k = 0; k < warmup; ++k) step(model, state, dt, warm);
+    for (int k = 0; k < warmup; ++k) step(model, state, next_step(), warm);
+    const Index biot_calls_before = state.structures.timings.biot_calls;
 
     StepProfile profile;
     std::vector<Real> errors;
@@ -54,7 +59,7 @@ int main(int argc, char** argv) {
     Stopwatch watch;
     for (int k = 0; k < steps; ++k) {
         particle_steps += double(state.fluid.size() + state.porous.size());
-        const StepReport r = step(model, state, dt, profile);
+        const StepReport r = step(model, state, next_step(), profile);
         errors.push_back(r.max_density_error);
         iterations += r.pressure_iterations;
         divergence_iterations += r.divergence_iterations;
@@ -69,6 +74,13 @@ int main(int argc, char** argv) {
     if (state.porous.size() > 0)
         fmt::print("  {:.3f} kg absorbed, {} pore-flow sub-steps per step\n", state.porous.absorbed,
                    double(state.porous.pore_substeps) / (steps + warmup));
+    if (!state.structures.empty()) {
+        const PfemTimings& t = state.structures.timings;
+        fmt::print("  structure stage: {} Biot calls in the timed steps ({} in all, {:.2f} iterations each), {} elements; since t = 0: "
+                   "meshing {:.3f} s, assembly {:.3f} s, factorisation {:.3f} s, iterations {:.3f} s\n",
+                   t.biot_calls - biot_calls_before, t.biot_calls, t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0,
+                   structure_mesh_quality(state).elements, t.meshing, t.assembly, t.factorisation, t.iterations);
+    }
     fmt::print("  {}: {:.0f} particle-steps/s, {:.4f} MIPPS, {:.1f} ms per step, {:.2f} density + {:.2f} divergence iterations per step\n",
                dfsph ? "DFSPH" : "PCISPH", particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps,
                double(iterations) / steps, double(divergence_iterations) / steps);
@@ -77,22 +89,16 @@ int main(int argc, char** argv) {
     for (size_t s = 0; s < size_t(Stage::Count); ++s)
         fmt::print("  {:22s} {:8.4f} s per step\n", k_stage_names[s], profile.seconds[s] / steps);
 
-    char host[256] = "unknown";
-    gethostname(host, sizeof host - 1);
-    const std::filesystem::path dir = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core";
-    std::filesystem::create_directories(dir);
-    const auto file = dir / (scene + (dfsph ? "_dfsph" : "") + ".csv");
-    const bool fresh = !std::filesystem::exists(file);
-    std::ofstream csv(file, std::ios::app);
-    if (fresh) {
-        csv << "threads,steps,particles,particle_steps_per_s,mipps,ms_per_step,iterations_per_step,mean_density_error,p99_density_error";
-        for (auto name : k_stage_names) csv << ",s_" << name;
-        csv << "\n";
-    }
+    std::string header = "threads,steps,particles,particle_steps_per_s,mipps,ms_per_step,iterations_per_step,mean_density_error,p99_density_error";
+    for (auto name : k_stage_names) header += ",s_" + std::string(name);
+    header += ",biot_calls";
+    const auto file = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core" / (scene + (dfsph ? "_dfsph" : "") + ".csv");
+    std::ofstream csv = bench::open_results(file, header);
+    csv << bench::provenance_fields(KARST_SOURCE_DIR);
     csv << fmt::format("{},{},{},{:.0f},{:.5f},{:.2f},{:.2f},{:.5f},{:.5f}", ThreadLimit::active_threads(), steps,
                        state.fluid.size() + state.porous.size(), particle_steps / seconds, particle_steps / seconds / 1e6, 1e3 * seconds / steps,
                        double(iterations) / steps, mean_error, p99);
     for (double s : profile.seconds) csv << fmt::format(",{:.5f}", s / steps);
-    csv << "\n";
+    csv << fmt::format(",{}\n", state.structures.timings.biot_calls - biot_calls_before);
     fmt::print("  appended to {}\n", file.string());
 }

@@ -6,7 +6,8 @@
 #include "support/simulate.hpp"
 
 #include "karst/core/parallel.hpp"
-#include "karst/pfem/fragment_structure.hpp"
+#include "karst/pfem/biot_setup.hpp"
+#include "karst/pfem/structure_stages.hpp"
 
 #include <gtest/gtest.h>
 
@@ -45,11 +46,11 @@ Real mean_sinking(const PorousParticles& p, const std::vector<Vec3>& rest_by_id,
 
 /// Steps to `end` with dt = 2 ms and the Biot step; returns the mean downward force of the fluid
 /// on the porous particles after `from`, N.
-Real run_and_mean_load(test::Simulation& sim, FragmentStructures& structures, Real from, Real end) {
+Real run_and_mean_load(test::Simulation& sim, Real from, Real end) {
     Real sum = 0;
     int samples = 0;
     while (sim.state.time < end - 1e-9) {
-        step(sim.model, sim.state, 0.002, sim.profile, &structures);
+        step(sim.model, sim.state, 0.002, sim.profile);
         if (sim.state.time > from) {
             for (const Vec3& f : sim.state.porous_scratch.force) sum -= f[2];
             ++samples;
@@ -73,20 +74,19 @@ const PointArray& array(const PointSet& set, const std::string& name) {
 TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquivalentTraction) {
     ThreadLimit one(1);
     test::Simulation sim(loaded_block_scene(1e5));
-    FragmentStructures structures(sim.model, sim.state.porous);
-    ASSERT_FALSE(structures.empty());
+    ASSERT_FALSE(sim.state.structures.empty());
     const std::vector<Vec3> rest = positions_by_id(sim.state.porous.particles);
     const Real g = 9.81, fluid_weight = g * sim.model.particle_mass * Real(sim.state.fluid.size());
-    const Real load = run_and_mean_load(sim, structures, 0.6, 1.0);
+    const Real load = run_and_mean_load(sim, 0.6, 1.0);
     // 1. The block carries the water's weight (less the little it absorbed): the loads are right.
     const Real water_weight = fluid_weight - g * sim.state.porous.absorbed;
     EXPECT_NEAR(load, water_weight, 0.05 * water_weight) << "mean vertical fluid load over 0.6-1 s, N";
-    EXPECT_EQ(structures.timings().biot_calls, 50);
+    EXPECT_EQ(sim.state.structures.timings.biot_calls, 50);
 
     // 2. Its top settles as a drained Biot solve of the same mesh under the same mean load as a
     //    uniform traction q on the top facets.
     MeshFrame coupled;
-    structures.append_to(coupled);
+    append_structure_meshes(sim.model, sim.state, coupled);
     PfemTimings timings;
     const TetMesh mesh = mesh_points(sim.model, coupled.nodes.x, timings);
     ASSERT_EQ(mesh.node_count(), Index(coupled.nodes.x.size()));
@@ -122,11 +122,10 @@ TEST(CoupledStructure, AJellySoftBlockDistortsItsMeshAndIsRemeshedOnItsDeformedS
     // flatten elements below 2 degrees and it is remeshed on its deformed positions (§4.10).
     ThreadLimit one(1);
     test::Simulation sim(loaded_block_scene(1e3));
-    FragmentStructures structures(sim.model, sim.state.porous);
     const std::vector<Vec3> rest = positions_by_id(sim.state.porous.particles);
     const Real dx = sim.model.dx;
-    while (sim.state.time < 0.3 - 1e-9) step(sim.model, sim.state, 0.002, sim.profile, &structures);
-    EXPECT_GE(structures.timings().remeshes, 1);
+    while (sim.state.time < 0.3 - 1e-9) step(sim.model, sim.state, 0.002, sim.profile);
+    EXPECT_GE(sim.state.structures.timings.remeshes, 1);
     // The remeshes carry the deformation on: the top has sunk by over a quarter of a spacing, and
     // no particle left the tank or the block's footprint.
     EXPECT_LT(mean_sinking(sim.state.porous.particles, rest, 0.05 - 1e-9), -0.25 * dx);
@@ -149,15 +148,14 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     // default); M22's default of 5 leaves about 2e-2.
     ThreadLimit one(1);
     test::Simulation sim(loaded_block_scene(1e5, R"(, "pressure_source": "biot", "max_iterations": 20)"));
-    FragmentStructures structures(sim.model, sim.state.porous);
-    const Real load = run_and_mean_load(sim, structures, 0.5, 0.8);
-    EXPECT_TRUE(structures.timings().all_converged);
+    const Real load = run_and_mean_load(sim, 0.5, 0.8);
+    EXPECT_TRUE(sim.state.structures.timings.all_converged);
     const BiotMaterial m = biot_material(sim.model, sim.model.scene.porous_solids[0].material);
     const Real M = 1 / m.storage, E_oed = m.lame_lambda() + 2 * m.shear_modulus();
     const Real q = load / (0.4 * 0.4);
     const Real undrained = m.biot_coefficient * M * q / (E_oed + m.biot_coefficient * m.biot_coefficient * M);
     MeshFrame frame;
-    structures.append_to(frame);
+    append_structure_meshes(sim.model, sim.state, frame);
     // The middle of the block, a block height and more from the side walls, which anchor its
     // edges and so take part of the load there.
     const PointArray& p = array(frame.nodes, "pore_pressure");

@@ -1,8 +1,9 @@
 // Poroelastic-only scenes (issue 4): porous solids with regions for boundary conditions, run by
-// the Biot solver alone. Terzaghi through the shipped scene, scene errors, and the output folder.
+// the Biot solver alone, through the same step() as every run. Terzaghi through the shipped
+// scene, scene errors, and the output folder.
 #include "support/files.hpp"
+#include "support/simulate.hpp"
 
-#include "karst/pfem/poroelastic_solid.hpp"
 #include "karst/pfem/porosity.hpp"
 #include "karst/scene/scene_error.hpp"
 
@@ -36,27 +37,26 @@ Real terzaghi_pressure(Real z, Real t, Real h) {
 }
 
 TEST(PoroelasticScene, ShippedTerzaghiSceneConsolidatesLikeTheSeries) {
-    const Model model = build_model(load_scene_file(k_scene));
-    ASSERT_EQ(model.porous.size(), 1u);
-    PfemTimings timings;
-    PoroelasticSolid solid(model, model.porous[0], timings);
+    test::Simulation sim(read_text(k_scene));
+    ASSERT_EQ(sim.state.structures.structures.size(), 1u);
     // The particles sit half a spacing inside the 10 m box: the mesh column is 9.75 m high.
     const Real base = 0.125, h = 9.75, t_end = 1.4;
-    for (Real t = 0; t < t_end - 1e-12; t += model.scene.poroelastic.time_step) solid.advance(model.scene.poroelastic.time_step, timings);
+    sim.run_until(t_end - 1e-9);
+    const Structure& s = sim.state.structures.structures[0];
     Real err2 = 0, ref2 = 0;
-    for (Index a = 0; a < solid.mesh().node_count(); ++a) {
-        const Real exact = terzaghi_pressure(solid.mesh().nodes[a][2] - base, t_end, h);
-        err2 += std::pow(solid.fields().p[a] - exact, 2), ref2 += exact * exact;
+    for (Index a = 0; a < s.mesh.node_count(); ++a) {
+        const Real exact = terzaghi_pressure(s.mesh.nodes[a][2] - base, t_end, h);
+        err2 += std::pow(s.fields.p[a] - exact, 2), ref2 += exact * exact;
     }
     EXPECT_LT(std::sqrt(err2 / ref2), 0.03) << "L2 error of the pore pressure over the column";
-    EXPECT_GT(timings.biot_calls, 0);
+    EXPECT_EQ(sim.state.structures.timings.biot_calls, std::lround(t_end / sim.model.scene.poroelastic.time_step));
 }
 
 TEST(PoroelasticScene, CompactionLowersPermeabilityByKozenyCarman) {
     // A drained, laterally confined block pressed from the top by 0.1 MPa: uniform strain
     // eps_zz = -q / (lambda + 2 mu), so M23 and M24 give one permeability for every tet.
-    const Model model = build_model(parse_scene(R"({
-      "name": "compaction", "particle_spacing": 0.25, "gravity": [0, 0, 0],
+    test::Simulation sim(R"({
+      "name": "compaction", "particle_spacing": 0.25, "gravity": [0, 0, 0], "poroelastic": { "time_step": 1.0 },
       "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [1, 1, 1] },
         "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "poisson_ratio": 0.25, "biot_coefficient": 0.9 },
         "constraints": [
@@ -67,35 +67,33 @@ TEST(PoroelasticScene, CompactionLowersPermeabilityByKozenyCarman) {
           { "kind": "fixed", "axes": "z", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 0] } },
           { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
           { "kind": "traction", "traction": [0, 0, -1e5], "region": { "type": "box", "min": [-1, -1, 1], "max": [2, 2, 2] } } ] } ]
-    })"));
-    PfemTimings timings;
-    PoroelasticSolid solid(model, model.porous[0], timings);
-    solid.advance(1.0, timings);
-    const BiotMaterial& m = solid.problem().material;
+    })");
+    sim.advance();
+    ASSERT_EQ(sim.state.structures.timings.biot_calls, 1);
+    const Structure& s = sim.state.structures.structures[0];
+    const BiotProblem& problem = sim.state.biot_cache.find(0, s.mesh_version)->solver->problem();
+    const BiotMaterial& m = problem.material;
     const Real eps_v = -1e5 / (m.lame_lambda() + 2 * m.shear_modulus());
     const Real k = kozeny_carman_permeability(1e-10, 0.3, dynamic_porosity(0.3, eps_v, 0, 1e30));
     ASSERT_LT(k, 0.9e-10) << "a 10 % compaction must close pores";
-    for (const Mat3& mobility : solid.problem().mobility) ASSERT_NEAR(mobility(0, 0) * 0.1 / k, 1, 1e-6);  // eta = 0.1
+    for (const Mat3& mobility : problem.mobility) ASSERT_NEAR(mobility(0, 0) * 0.1 / k, 1, 1e-6);  // eta = 0.1
 }
 
 TEST(PoroelasticScene, SoakSceneSpreadsAlongTheLayersAndKeepsItsWater) {
     // scenes/soak_layered_block.json: a wet ball in a block layered 4 : 1 (normal z).
-    const Model model = build_model(load_scene_file(std::string(KARST_SOURCE_DIR) + "/scenes/soak_layered_block.json"));
-    PfemTimings timings;
-    PoroelasticSolid solid(model, model.porous[0], timings);
+    test::Simulation sim(read_text(std::string(KARST_SOURCE_DIR) + "/scenes/soak_layered_block.json"));
     auto moments = [&] {
-        PointSet points;
-        solid.append_particles_to(points);
-        const auto& m = std::find_if(points.arrays.begin(), points.arrays.end(), [](const PointArray& a) { return a.name == "absorbed_mass"; })->values;
+        const PorousParticles& p = sim.state.porous.particles;
         Real total = 0;
         Vec3 mean = Vec3::Zero(), second = Vec3::Zero();
-        for (size_t i = 0; i < m.size(); ++i) total += m[i], mean += m[i] * points.x[i];
+        for (Index i = 0; i < p.size(); ++i) total += p.absorbed_mass[i], mean += p.absorbed_mass[i] * p.x[i];
         mean /= total;
-        for (size_t i = 0; i < m.size(); ++i) second += m[i] * (points.x[i] - mean).cwiseAbs2();
+        for (Index i = 0; i < p.size(); ++i) second += p.absorbed_mass[i] * (p.x[i] - mean).cwiseAbs2();
         return std::pair{total, Vec3(second / total)};
     };
     const auto [water0, var0] = moments();
-    for (int step = 0; step < 30; ++step) solid.advance(model.scene.poroelastic.time_step, timings);
+    for (int step = 0; step < 30; ++step) sim.advance();
+    EXPECT_EQ(sim.state.structures.timings.biot_calls, 30);
     const auto [water1, var1] = moments();
     EXPECT_NEAR(water1, water0, 1e-12 * water0) << "pore water is conserved";
     const Real along = 0.5 * (var1[0] - var0[0] + var1[1] - var0[1]), across = var1[2] - var0[2];

@@ -172,7 +172,7 @@ private:
 }  // namespace
 
 struct BiotSolver::Impl {
-    const TetMesh& mesh;
+    const TetMesh mesh;  // a copy: the solver is a cache that outlives moves of the state's mesh
     BiotProblem problem;
     BiotOptions options;
     Index n = 0;

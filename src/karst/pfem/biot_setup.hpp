@@ -1,21 +1,14 @@
 #pragma once
 // From a scene's porous solid to its Biot problem (method.md §5.1-5.5): the mesh of a point set,
 // the Biot material and boundary conditions, the solver options, the porosity and permeability
-// feedback at the nodes, and the mesh frame arrays. Shared by poroelastic-only solids and the
-// anchored fragments of coupled runs.
+// feedback at the nodes, and the mesh frame arrays.
 #include "karst/io/frame_writer.hpp"
 #include "karst/pfem/biot.hpp"
 #include "karst/pfem/nodal_stress.hpp"
+#include "karst/pfem/structure_state.hpp"
 #include "karst/sim/model.hpp"
 
 namespace karst {
-
-/// Seconds spent per PFEM phase, summed over solids and calls (stats.json "phases").
-struct PfemTimings {
-    Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0, pore_flow = 0;
-    Index biot_calls = 0, biot_iterations = 0, remeshes = 0;
-    bool all_converged = true;
-};
 
 /// §5.1 mesh of the points x (rest positions, spacing dx) with the scene's alpha, delta and
 /// weighted-alpha settings.

@@ -13,7 +13,12 @@ Energy mechanical_energy(const Model& model, const State& state) {
     Energy e;
     e.kinetic = deterministic_sum(f.size(), Real(0), [&](Index i) { return 0.5 * f.mass[i] * f.v[i].squaredNorm(); });
     e.potential = deterministic_sum(f.size(), Real(0), [&](Index i) { return -f.mass[i] * g.dot(f.x[i]); });
+    // An anchored fragment's particles move only as its quasi-static Biot displacement says
+    // (their velocity spreads a call's u over dt_B, for the fluid's sake): no inertia, no
+    // kinetic energy. Free fragments carry theirs.
+    const std::vector<Fragment>& fragments = state.porous.fragments;
     e.kinetic += deterministic_sum(p.size(), Real(0), [&](Index i) {
+        if (fragments[p.fragment[i]].anchored) return Real(0);
         return 0.5 * (p.solid_mass[i] + p.absorbed_mass[i]) * p.v[i].squaredNorm();
     });
     e.potential += deterministic_sum(p.size(), Real(0), [&](Index i) { return -(p.solid_mass[i] + p.absorbed_mass[i]) * g.dot(p.x[i]); });

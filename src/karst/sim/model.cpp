@@ -213,7 +213,7 @@ void set_up_porous_materials(Model& m) {
 void check_biot_setup(const Model& m) {
     const Scene& scene = m.scene;
     for (const PorousSolid& s : scene.porous_solids) {
-        if (!m.coupled()) {
+        if (m.poroelastic_only()) {
             if (s.material.porosity < k_min_porosity)
                 throw SceneError(s.path + "/material/porosity",
                                  "a porosity of at least 1e-4 in a poroelastic-only scene (an impermeable solid has no pore pressure)",

@@ -52,6 +52,8 @@ struct Model {
     UniformGrid porous_grid;      ///< cell = the longest porous kernel reach (M13), at least h
     /// Porous solids run coupled with the fluid as rigid fragments; else they are poroelastic-only.
     bool coupled() const { return !porous.empty() && (!initial_x.empty() || any_free_solid()); }
+    /// Porous solids alone, all anchored, no fluid: the Biot solver runs by itself.
+    bool poroelastic_only() const { return !porous.empty() && !coupled(); }
     bool any_free_solid() const {
         for (const PorousSolid& s : scene.porous_solids) if (!s.anchored) return true;
         return false;

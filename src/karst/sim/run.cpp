@@ -5,13 +5,12 @@
 #include "karst/coupling/porous_boundary_volumes.hpp"
 #include "karst/coupling/porous_neighbours.hpp"
 #include "karst/io/frame_writer.hpp"
-#include "karst/pfem/fragment_structure.hpp"
+#include "karst/pfem/structure_stages.hpp"
 #include "karst/porous/porous_points.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/energy.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
-#include "karst/sim/run_poroelastic.hpp"
 #include "karst/sim/step.hpp"
 #include "karst/sim/watchdog.hpp"
 #include "karst/sph/density.hpp"
@@ -21,7 +20,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <optional>
 
 namespace karst {
 
@@ -50,12 +48,9 @@ Index live_fragments(const State& s) {
     return n;
 }
 
-/// Step length that reaches `target` in a whole number of steps no longer than dt_cfl, so
-/// frames land on their exact times without a sliver step.
-Real step_towards(Real dt_cfl, Real now, Real target) {
-    const Real remaining = target - now;
-    const Real n = std::max(Real(1), std::ceil(remaining / dt_cfl - 1e-9));
-    return remaining / n;
+nlohmann::json biot_stats(const PfemTimings& t) {
+    return {{"calls", t.biot_calls}, {"iterations", t.biot_iterations}, {"remeshes", t.remeshes},
+            {"mean_iterations", t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0}, {"all_converged", t.all_converged}};
 }
 
 /// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current
@@ -85,12 +80,10 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
-    if (!model.porous.empty() && !model.coupled()) return run_poroelastic(model, opt);
     State state = make_initial_state(model);
     const bool porous = state.porous.size() > 0;
-    std::optional<FragmentStructures> structures;
-    if (porous && scene.poroelastic.coupled_fragments) structures.emplace(model, state.porous);
-    const bool meshes = structures && !structures->empty();
+    const bool meshes = !state.structures.empty();
+    const bool fluid_frames = !model.poroelastic_only();
 
     RunResult result;
     result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
@@ -120,8 +113,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         PointSet porous_points;
         if (porous) porous_points = porous_frame(model, state);
         MeshFrame mesh;
-        if (meshes) structures->append_to(mesh);
-        out.write_frame({&state.fluid, meshes ? &mesh : nullptr, porous ? &porous_points : nullptr}, log);
+        if (meshes) append_structure_meshes(model, state, mesh);
+        out.write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr, porous ? &porous_points : nullptr}, log);
     };
 
     // Densities of the initial state, so frame 0 shows them.
@@ -149,13 +142,14 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         const MassTotals final_totals = mass_totals(state);
         nlohmann::json phases;
         for (size_t s = 0; s < size_t(Stage::Count); ++s) phases[std::string(k_stage_names[s])] = profile.seconds[s];
-        const PfemTimings pfem = structures ? structures->timings() : PfemTimings{};
+        const PfemTimings& pfem = state.structures.timings;
+        const MeshQuality quality = structure_mesh_quality(state);
         phases["meshing"] = pfem.meshing, phases["assembly"] = pfem.assembly;
         phases["factorisation"] = pfem.factorisation, phases["iterations"] = pfem.iterations;
         return nlohmann::json{
             {"scene", scene.name},
             {"counts", {{"fluid", state.fluid.size()}, {"boundary", model.walls.size()}, {"porous", state.porous.size()},
-                        {"elements", structures ? structures->elements() : 0}, {"fragments", live_fragments(state)}, {"removed", state.removed},
+                        {"elements", quality.elements}, {"fragments", live_fragments(state)}, {"removed", state.removed},
                         {"pushed_back", state.pushed_back},
                         {"porous_removed", state.porous.removed}, {"dissolved", state.porous.dissolved},
                         {"fluid_drained", state.porous.fluid_deleted}}},
@@ -171,6 +165,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                       {"grains_initial", initial.grains}, {"grains_final", final_totals.grains}}},
             {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
             {"biot", biot_stats(pfem)},
+            {"mesh", {{"kept", quality.kept}, {"polyhedra", quality.polyhedra}, {"slivers_dropped", quality.slivers_dropped},
+                      {"interior_slivers", quality.interior_slivers}}},
             {"max_density_error", max_density_error},
             {"energy", {{"released", energy.released()}, {"largest_gain", energy.largest_gain()},
                         {"largest_rise_over_start", energy.largest_rise_over_start()}}},
@@ -183,16 +179,14 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     try {
         while (state.time < end - 1e-12 * std::max(Real(1), end)) {
             const Real frame_time = std::min(end, next_frame * frame_dt);
-            Real dt = cfl_time_step(model, state);
-            const Real target = meshes ? std::min(frame_time, state.time + structures->time_to_next_call(model)) : frame_time;
-            if (!scene.time.fixed_dt) dt = step_towards(dt, state.time, target);
+            const Real dt = next_step_length(model, state, frame_time);
             last_good = state.fluid;
             if (porous) last_good_porous = state.porous;
             const Real last_good_time = state.time;
             StepReport report;
             try {
                 Stopwatch step_watch;
-                report = step(model, state, dt, profile, structures ? &*structures : nullptr);
+                report = step(model, state, dt, profile);
                 frame_step_seconds += step_watch.seconds();
             } catch (const WatchdogError&) {
                 // Keep what was good: the state before the failing step becomes the last frame.
@@ -219,7 +213,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             const double rate = state.time / std::max(elapsed, 1e-9);
             progress.update({out.frames() - 1, state.time, end, state.steps / std::max(elapsed, 1e-9),
                              particle_steps / std::max(elapsed, 1e-9) / 1e6, (end - state.time) / std::max(rate, 1e-12),
-                             state.fluid.size(), porous ? state.porous.absorbed : -1.0, state.removed});
+                             fluid_frames ? state.fluid.size() : state.porous.size(), porous ? state.porous.absorbed : -1.0, state.removed});
         }
     } catch (const WatchdogError& e) {
         progress.finish();

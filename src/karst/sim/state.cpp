@@ -1,6 +1,7 @@
 #include "karst/sim/state.hpp"
 
 #include "karst/core/soa.hpp"
+#include "karst/pfem/structure_stages.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/porous_materials.hpp"
 
@@ -23,7 +24,6 @@ namespace {
 /// Porous particles of every solid (method.md §2) and one fragment per solid (§4.5), at rest or
 /// with a free solid's initial velocity and spin.
 void make_porous(const Model& model, PorousState& porous) {
-    if (!model.coupled()) return;
     PorousParticles& p = porous.particles;
     for (const PorousBody& body : model.porous) {
         const PorousSolid& solid = model.scene.porous_solids[body.solid];
@@ -65,6 +65,7 @@ State make_initial_state(const Model& model) {
     for (size_t i = 0; i < n; ++i) s.fluid.id[i] = std::int64_t(i);
     s.next_id = std::int64_t(n);
     make_porous(model, s.porous);
+    build_structures(model, s);
     return s;
 }
 

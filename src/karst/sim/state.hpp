@@ -2,6 +2,7 @@
 // The mutable state (style.md P3/P4): fluid particles as one array per attribute, the time, and
 // per-step derived data (neighbour lists, accelerations) kept apart from the physical state.
 #include "karst/core/types.hpp"
+#include "karst/pfem/structure_state.hpp"
 #include "karst/porous/pore_flow.hpp"
 #include "karst/porous/pore_water.hpp"
 #include "karst/rigid/fragment.hpp"
@@ -101,6 +102,8 @@ struct State {
     FluidScratch scratch;
     PorousState porous;
     PorousScratch porous_scratch;
+    StructureState structures;    ///< Algorithm 2's meshes and fields (method.md §5)
+    BiotCache biot_cache;         ///< their solvers, rebuilt on demand
     Real time = 0;                ///< s
     Index steps = 0;
     Real dt = 0;                  ///< last step, s
@@ -114,7 +117,8 @@ struct State {
 };
 
 /// Fluid at t = 0 from the model's sampled blocks; porous particles and their fragments at rest
-/// (or with a free solid's initial velocity).
+/// (or with a free solid's initial velocity); the meshes and Biot problems of the anchored
+/// fragments of permeable solids.
 State make_initial_state(const Model& model);
 
 }  // namespace karst

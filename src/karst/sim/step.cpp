@@ -1,12 +1,15 @@
-// THE order of the stages of one time step (method.md §3, style.md P2). Every stage is timed
-// into the profile and followed by the watchdog's check of what it wrote.
+// THE order of the stages of one time step: Algorithm 1 (method.md §3) and, after the rigid
+// update, Algorithm 2 (§5). Every stage is timed into the profile and followed by the watchdog's
+// check of what it wrote. Numbers are the sheet's §3 steps; two run earlier than the sheet
+// lists them: solute diffusion (10) and the pore flow (8) use the neighbour lists of the step's
+// start positions, so they run before anything moves (5-7).
 #include "karst/sim/step.hpp"
 
 #include "karst/core/timer.hpp"
 #include "karst/coupling/fluid_reactions.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
 #include "karst/coupling/porous_neighbours.hpp"
-#include "karst/pfem/fragment_structure.hpp"
+#include "karst/pfem/structure_stages.hpp"
 #include "karst/porous/dissolution.hpp"
 #include "karst/porous/drained_fluid.hpp"
 #include "karst/porous/pore_flow.hpp"
@@ -18,6 +21,8 @@
 #include "karst/sph/non_pressure_forces.hpp"
 #include "karst/sph/pcisph.hpp"
 #include "karst/sph/solute_diffusion.hpp"
+
+#include <cmath>
 
 namespace karst {
 
@@ -89,9 +94,28 @@ void dissolve_particles(const Model& model, State& state) {
     if (r.dissolved > 0) state.porous_scratch.pairs_stale = true;
 }
 
+/// Step length that reaches `target` in a whole number of steps no longer than dt_bound, so
+/// frames and Biot calls land on their exact times without a sliver step.
+Real step_towards(Real dt_bound, Real now, Real target) {
+    const Real remaining = target - now;
+    const Real n = std::max(Real(1), std::ceil(remaining / dt_bound - 1e-9));
+    return remaining / n;
+}
+
 }  // namespace
 
-StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& profile, FragmentStructures* structures) {
+Real next_step_length(const Model& model, const State& state, Real target) {
+    if (model.poroelastic_only()) {
+        target = std::min(target, state.time + time_to_next_biot_call(model, state));
+        return step_towards(model.scene.poroelastic.time_step, state.time, target);
+    }
+    const Real dt = cfl_time_step(model, state);
+    if (model.scene.time.fixed_dt) return dt;
+    target = std::min(target, state.time + time_to_next_biot_call(model, state));
+    return std::isfinite(target) ? step_towards(dt, state.time, target) : dt;
+}
+
+StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& profile) {
     const Real t = state.time;
     const auto& id = state.fluid.id;
     const bool porous = state.porous.size() > 0;
@@ -134,42 +158,46 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
     update_solver_time_step_limit(state, dt, dt < dt_wanted, converged, model.scene.time.dt_max);
 
-    // 4a. Solute diffusion among fluid particles (M18), on this step's densities and lists.
+    // 10. Solute diffusion among fluid particles (M18), on this step's densities and lists.
     timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });
     check_scalars(state.fluid.solute, id, Stage::SoluteDiffusion, t, "solute mass");
 
     if (porous) {
-        // 4b. The fluid's last pressure, friction and adhesion act back on the porous particles.
-        timed(profile, Stage::FluidReactions, [&] {
-            compute_fluid_reactions(model, state);
-            // They are the nodal loads of the next Biot call (§4.3, §5.3), summed over its interval.
-            if (structures && !structures->empty()) structures->add_loads(state.porous.particles, state.porous_scratch.force, dt);
-        });
-        // 5. Pore flow, absorption and drained fluid (§4.7), before anything moves.
+        // 3b. The fluid's last pressure, friction and adhesion act back on the porous particles.
+        timed(profile, Stage::FluidReactions, [&] { compute_fluid_reactions(model, state); });
+        // 8. Pore flow, absorption and drained fluid (§4.7), before anything moves.
         timed(profile, Stage::PoreFlow, [&] { pore_flow_and_absorption(model, state, dt); });
         check_scalars(state.porous.particles.absorbed_mass, {}, Stage::PoreFlow, t, "absorbed mass");
     }
 
-    // 6. Symplectic Euler; particles leaving the domain, or drained, are removed (§4.4).
+    // 5. Symplectic Euler; particles leaving the domain, or drained, are removed (§4.4).
     state.a_max = timed(profile, Stage::Integrate, [&] { return integrate_fluid(model, state, dt); });
     check_vectors(state.fluid.v, state.fluid.id, Stage::Integrate, t + dt, "velocity", model.scene.max_speed);
     check_vectors(state.fluid.x, state.fluid.id, Stage::Integrate, t + dt, "position");
 
     if (porous) {
-        // 7. Fragments: contacts, rigid integration, members follow (§4.5).
+        // 6-7. Fragments: contacts, rigid integration, members follow (§4.5).
         timed(profile, Stage::Fragments, [&] { advance_fragments(model, state, dt); });
-        // 8. Dissolution into muddy fluid (§4.8); the fragments' mass properties follow the
+        // 11a. Loads of the next Biot call (§5.3): this step's forces on the porous particles,
+        //      the fluid's reactions and now the contacts too, summed over the call's interval.
+        timed(profile, Stage::Structure, [&] { add_structure_loads(state, dt); });
+        // 9. Dissolution into muddy fluid (§4.8); the fragments' mass properties follow the
         //    pore water and the members they lost.
         timed(profile, Stage::Dissolution, [&] {
             dissolve_particles(model, state);
             refresh_fragment_mass(state, model.dx);
         });
-        // 9. Algorithm 2 on the anchored fragments every dt_B (§5): the Biot call takes the mean
-        //    fluid loads since the last one, and its porosity and permeability feed the pores.
-        if (structures && !structures->empty())
-            timed(profile, Stage::Structure, [&] {
-                if (structures->advance(model, state.porous)) state.porous_scratch.pairs_stale = true;
-            });
+        // 11. Algorithm 2 on the anchored fragments every dt_B (§5): the members move toward the
+        //     last call's X + u (7, elastic part); when a call is due, remesh triggers (§4.10),
+        //     the Biot call on the mean loads (M22), and the feedback into the pores (§5.4).
+        timed(profile, Stage::Structure, [&] {
+            follow_structure_displacement(model, state);
+            if (!biot_call_due(model, state)) return;
+            remesh_structures(model, state);
+            solve_structures(model, state);
+            if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
+        });
+        // (12. Topology after fracture: the next issue.)
     }
 
     state.time = t + dt;

@@ -1,0 +1,271 @@
+#include "karst/pfem/structure_stages.hpp"
+
+#include "karst/core/parallel.hpp"
+#include "karst/pfem/biot_setup.hpp"
+#include "karst/pfem/face_links.hpp"
+
+#include <limits>
+
+namespace karst {
+
+namespace {
+
+/// A fragment is remeshed once it has lost this fraction of its nodes (to dissolution or the
+/// domain) [D]: the sheet remeshes at every topology event (§4.10), but an eroding rock loses a
+/// few grains at most steps, and each remesh refactorises the elasticity. Until then the lost
+/// nodes keep their stiffness and take no load.
+constexpr Real k_remesh_lost_fraction = 0.01;
+
+/// §4.10: a deformed element with a dihedral angle under this many degrees (or inverted) triggers
+/// a remesh. Interior slivers that were under it at rest (tet_mesh.hpp) do not count.
+constexpr Real k_distorted_dihedral_deg = 2;
+
+/// Particle index of each porous particle id, -1 for ids no longer present.
+std::vector<Index> index_by_id(const PorousParticles& p, size_t ids) {
+    std::vector<Index> index(ids, -1);
+    for (Index i = 0; i < p.size(); ++i) index[p.id[i]] = i;
+    return index;
+}
+
+/// The solver of structure `slot`, built (and its mobility brought to the last feedback) when
+/// the cache has none for the current mesh.
+BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
+    Structure& s = state.structures.structures[slot];
+    if (BiotCache::Entry* e = state.biot_cache.find(slot, s.mesh_version)) return *e->solver;
+    BiotCache::Entry& e = state.biot_cache.reset(slot);
+    const PorousSolid& solid = model.scene.porous_solids[s.solid];
+    BiotProblem problem = biot_problem(model, solid, s.mesh, s.node_tensors);
+    // [D] Geostatic start in a coupled run: a fragment's rest state is its state at rest under
+    // its own weight, so gravity (body force and gravity flux) leaves the problem and u, eps_v
+    // and p are the response to the fluid's loads and to the pore overpressure P^p (M5, zero up
+    // to S = 1). With gravity in, a resting block of E = 1 MPa soil consolidated under its own
+    // weight at t = 0, and its porosity fell and its pore pressure rose before any water
+    // arrived. Biot is linear, so dropping a constant load only shifts the reference state. A
+    // poroelastic-only solid keeps gravity: consolidation under its weight is what it shows.
+    if (!model.poroelastic_only()) problem.gravity = Vec3::Zero();
+    e.solver.emplace(make_biot_solver(model, s.mesh, std::move(problem), state.structures.timings));
+    e.assembled_scale.assign(s.mesh.tet_count(), 1);
+    e.mesh_version = s.mesh_version;
+    refresh_mobility(*e.solver, s.mesh, solid.material, s.node_tensors, s.permeability_scale, e.assembled_scale);
+    return *e.solver;
+}
+
+/// Meshes structure `slot` on the rest positions of its fragment's present particles; u is
+/// carried per particle id, p starts at the drained pressure where drained and 0 elsewhere.
+void build(const Model& model, State& state, size_t slot) {
+    StructureState& st = state.structures;
+    Structure& s = st.structures[slot];
+    const PorousParticles& p = state.porous.particles;
+    std::vector<Vec3> x;
+    s.node_id.clear();
+    for (Index i = 0; i < p.size(); ++i)
+        if (p.fragment[i] == s.fragment) x.push_back(st.rest_x[p.id[i]]), s.node_id.push_back(p.id[i]);
+    s.mesh = mesh_points(model, x, st.timings);
+    s.mesh_version = st.next_mesh_version++;
+    s.links = face_links(s.mesh);
+    const Index n = s.mesh.node_count();
+    s.node_tensors.resize(n), s.fields.u.resize(n), s.fields.p.assign(n, 0), s.permeability_scale.assign(n, 1);
+    for (Index a = 0; a < n; ++a) {
+        const Index id = s.node_id[a];
+        st.node_of[id] = {Index(slot), a};
+        s.node_tensors[a] = st.rest_tensor[id], s.fields.u[a] = st.u[id];
+    }
+    s.u_from = s.fields.u;
+    s.distorted = false;
+    const BiotProblem& problem = solver_of(model, state, slot).problem();
+    for (Index a = 0; a < n; ++a)
+        if (problem.drained[a]) s.fields.p[a] = problem.drained_pressure.empty() ? 0 : problem.drained_pressure[a];
+    s.well_shaped.resize(s.mesh.tet_count());
+    for (Index e = 0; e < s.mesh.tet_count(); ++e) {
+        const Tet& t = s.mesh.tets[e];
+        s.well_shaped[e] = min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) >= k_distorted_dihedral_deg;
+    }
+}
+
+bool distorted(const Structure& s) {
+    std::vector<Vec3> x(s.mesh.node_count());
+    for (Index a = 0; a < s.mesh.node_count(); ++a) x[a] = s.mesh.nodes[a] + s.fields.u[a];
+    for (Index e = 0; e < s.mesh.tet_count(); ++e) {
+        if (!s.well_shaped[e]) continue;
+        const Tet& t = s.mesh.tets[e];
+        if (signed_volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) <= 0 || min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) < k_distorted_dihedral_deg)
+            return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+void build_structures(const Model& model, State& state) {
+    StructureState& st = state.structures;
+    const PorousParticles& p = state.porous.particles;
+    size_t ids = 0;
+    for (Index i = 0; i < p.size(); ++i) ids = std::max<size_t>(ids, size_t(p.id[i]) + 1);
+    st.impulse.assign(ids, Vec3::Zero()), st.u.assign(ids, Vec3::Zero()), st.rest_tensor.assign(ids, Mat3::Zero());
+    st.rest_x.assign(ids, Vec3::Zero()), st.node_of.assign(ids, {-1, -1});
+    st.paired_scale.assign(ids, 1), st.paired_volume.assign(ids, 0);
+    for (Index i = 0; i < p.size(); ++i) {
+        const Index id = p.id[i];
+        st.rest_tensor[id] = p.body_permeability[i], st.paired_volume[id] = p.volume[i], st.rest_x[id] = p.x[i];
+    }
+    if (model.coupled() && !model.scene.poroelastic.coupled_fragments) return;
+    const std::vector<Fragment>& fragments = state.porous.fragments;
+    for (size_t f = 0; f < fragments.size(); ++f) {
+        if (!fragments[f].anchored || fragments[f].mass <= 0) continue;
+        Index material = -1;  // the fragment's solid: its members share one material
+        for (Index i = 0; i < p.size() && material < 0; ++i)
+            if (p.fragment[i] == Index(f)) material = p.material[i];
+        if (model.scene.porous_solids[material].material.porosity < k_min_porosity) continue;  // a rigid boundary
+        Structure s;
+        s.fragment = Index(f), s.solid = material;
+        st.structures.push_back(std::move(s));
+        build(model, state, st.structures.size() - 1);
+    }
+}
+
+void add_structure_loads(State& state, Real dt) {
+    StructureState& st = state.structures;
+    if (st.empty()) return;
+    const PorousParticles& p = state.porous.particles;
+    const std::vector<Vec3>& force = state.porous_scratch.force;
+    parallel_for(p.size(), [&](Index i) { st.impulse[p.id[i]] += dt * force[i]; });
+    st.elapsed += dt;
+}
+
+void follow_structure_displacement(const Model& model, State& state) {
+    const StructureState& st = state.structures;
+    if (st.empty()) return;
+    // [D] Spread over the interval after the call that gave u^n: set at once, a call's
+    // displacement moved the fluid's boundary by up to 2 % of a spacing within one step. The
+    // pore-flow pairs need no rebuild for it: their conductances hold the distances between
+    // members, which change with the strain (feed_back_structures), not with the displacement.
+    const Real dt_B = model.scene.poroelastic.time_step, fraction = std::min<Real>(1, st.elapsed / dt_B);
+    PorousParticles& p = state.porous.particles;
+    parallel_for(p.size(), [&](Index i) {
+        const auto [slot, a] = st.node_of[p.id[i]];
+        if (slot < 0) return;
+        const Structure& s = st.structures[slot];
+        const Vec3 change = s.fields.u[a] - s.u_from[a];
+        p.x[i] = st.rest_x[p.id[i]] + s.u_from[a] + fraction * change;
+        p.v[i] = fraction < 1 ? Vec3(change / dt_B) : Vec3::Zero();
+    });
+}
+
+bool biot_call_due(const Model& model, const State& state) {
+    return !state.structures.empty() && state.structures.elapsed >= model.scene.poroelastic.time_step * (1 - 1e-9);
+}
+
+Real time_to_next_biot_call(const Model& model, const State& state) {
+    if (state.structures.empty()) return std::numeric_limits<Real>::infinity();
+    return model.scene.poroelastic.time_step - state.structures.elapsed;
+}
+
+void remesh_structures(const Model& model, State& state) {
+    StructureState& st = state.structures;
+    const std::vector<Index> index_of = index_by_id(state.porous.particles, st.node_of.size());
+    for (size_t slot = 0; slot < st.structures.size(); ++slot) {
+        Structure& s = st.structures[slot];
+        const Index n = s.mesh.node_count();
+        Index lost = 0;
+        for (Index a = 0; a < n; ++a) lost += index_of[s.node_id[a]] < 0;
+        if (lost > k_remesh_lost_fraction * n) {
+            for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
+        } else if (s.distorted) {
+            // [D] A distorted mesh is rebuilt on the deformed positions, which become the new
+            // rest state (u = 0 there): small-strain Biot cannot carry a deformation that inverts
+            // elements, so the stress it held is released, as in a soil that has flowed.
+            for (Index a = 0; a < n; ++a) st.rest_x[s.node_id[a]] += s.fields.u[a], st.u[s.node_id[a]] = Vec3::Zero();
+        } else {
+            continue;
+        }
+        build(model, state, slot);
+        ++st.timings.remeshes;
+    }
+}
+
+void solve_structures(const Model& model, State& state) {
+    StructureState& st = state.structures;
+    const PorousParticles& p = state.porous.particles;
+    const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
+    const Real dt = st.elapsed;
+    const bool from_pore_water = model.scene.poroelastic.pressure_from_pore_water;
+    for (size_t slot = 0; slot < st.structures.size(); ++slot) {
+        Structure& s = st.structures[slot];
+        BiotSolver& solver = solver_of(model, state, slot);
+        const PoreWaterLaw& law = model.pore_laws[s.solid];
+        const std::vector<char>& drained = solver.problem().drained;
+        std::vector<Vec3> loads(s.mesh.node_count(), Vec3::Zero());
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            const Index i = index_of[s.node_id[a]];
+            if (i < 0) continue;
+            loads[a] = st.impulse[s.node_id[a]] / dt;
+            if (from_pore_water && !drained[a])
+                s.fields.p[a] = law.pore_pressure(law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
+        }
+        solver.set_extra_loads(loads);
+        s.u_from = s.fields.u;  // where the particles are now
+        const BiotCallReport r = solver.advance(dt, s.fields);
+        st.timings.factorisation += r.seconds_flow_factorisation, st.timings.iterations += r.seconds_iterations;
+        ++st.timings.biot_calls, st.timings.biot_iterations += r.iterations;
+        st.timings.all_converged = st.timings.all_converged && r.converged;
+        s.distorted = distorted(s);
+    }
+    std::fill(st.impulse.begin(), st.impulse.end(), Vec3::Zero());
+    st.elapsed = 0;
+}
+
+bool feed_back_structures(const Model& model, State& state) {
+    if (!model.scene.poroelastic.permeability_feedback) return false;
+    StructureState& st = state.structures;
+    PorousParticles& p = state.porous.particles;
+    const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
+    const Real rest_volume = model.dx * model.dx * model.dx;
+    bool stale = false;
+    for (size_t slot = 0; slot < st.structures.size(); ++slot) {
+        Structure& s = st.structures[slot];
+        BiotSolver& solver = solver_of(model, state, slot);
+        const PorousMaterial& material = model.scene.porous_solids[s.solid].material;
+        const NodalStress stress = nodal_stress(s.mesh, solver.problem().material, s.fields);
+        const NodalPoreState pore = nodal_pore_state(material, solver.problem().material, stress, s.fields.p);
+        const Mat3 R = state.porous.fragments[s.fragment].rotation_matrix();
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            const Index i = index_of[s.node_id[a]];
+            if (i < 0) continue;
+            p.porosity[i] = pore.porosity[a];
+            p.volume[i] = rest_volume * (1 + stress.volumetric_strain[a]);
+            p.body_permeability[i] = pore.permeability_scale[a] * s.node_tensors[a];
+            p.permeability[i] = R * p.body_permeability[i] * R.transpose();
+            const Index id = s.node_id[a];
+            stale = stale || std::abs(pore.permeability_scale[a] / st.paired_scale[id] - 1) > 0.01 ||
+                    std::abs(p.volume[i] / st.paired_volume[id] - 1) > 0.01;
+        }
+        s.permeability_scale = pore.permeability_scale;
+        refresh_mobility(solver, s.mesh, material, s.node_tensors, s.permeability_scale,
+                         state.biot_cache.find(slot, s.mesh_version)->assembled_scale);
+    }
+    if (stale)
+        for (Index i = 0; i < p.size(); ++i)
+            st.paired_scale[p.id[i]] = p.body_permeability[i].trace() / st.rest_tensor[p.id[i]].trace(), st.paired_volume[p.id[i]] = p.volume[i];
+    return stale;
+}
+
+void append_structure_meshes(const Model& model, State& state, MeshFrame& frame) {
+    for (size_t slot = 0; slot < state.structures.structures.size(); ++slot) {
+        const Structure& s = state.structures.structures[slot];
+        append_mesh_frame(frame, s.mesh, solver_of(model, state, slot).problem(), s.fields,
+                          model.scene.porous_solids[s.solid].material, s.node_tensors);
+    }
+}
+
+MeshQuality structure_mesh_quality(const State& state) {
+    MeshQuality q;
+    for (const Structure& s : state.structures.structures) {
+        const MeshQuality& m = s.mesh.quality;
+        q.delaunay_cells += m.delaunay_cells, q.kept += m.kept, q.elements += m.elements;
+        q.slivers_dropped += m.slivers_dropped, q.interior_slivers += m.interior_slivers, q.polyhedra += m.polyhedra;
+        q.joined_polyhedra += m.joined_polyhedra, q.volume += m.volume;
+    }
+    return q;
+}
+
+}  // namespace karst

@@ -1,0 +1,94 @@
+#pragma once
+// The structure side's physical state (method.md §5), as plain data inside State: per anchored
+// fragment of a permeable solid its PFEM mesh on the rest positions, the links between its
+// elements, the Biot fields, and per porous particle id the rest position, displacement and the
+// loads summed since the last Biot call. The solvers (factorisations, AMG hierarchies) are not
+// state: BiotCache holds them, keyed by the mesh they were built on, and rebuilds them on demand.
+#include "karst/pfem/biot.hpp"
+#include "karst/pfem/tet_mesh.hpp"
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+namespace karst {
+
+/// Two elements sharing a face (method.md §5.5, M27): fracture breaks links, and the unbroken
+/// ones say which elements still hold together.
+struct ElementLink {
+    Index a = 0, b = 0;  ///< tets of the mesh, a < b
+};
+
+/// One anchored fragment's Biot problem.
+struct Structure {
+    Index fragment = 0;                ///< in PorousState::fragments
+    Index solid = 0;                   ///< in scene.porous_solids (its material and constraints)
+    std::int64_t mesh_version = 0;     ///< changes whenever the mesh is rebuilt (keys BiotCache)
+    std::vector<Index> node_id;        ///< porous particle id of each node
+    TetMesh mesh;                      ///< on the rest positions X (world frame: anchored)
+    std::vector<ElementLink> links;    ///< face adjacencies of mesh.tets
+    BiotFields fields;                 ///< u, p of the last call, per node
+    std::vector<Vec3> u_from;          ///< per node: u of the call before the last (the particles' start)
+    std::vector<Mat3> node_tensors;    ///< K0 per node (body frame), m^2
+    std::vector<Real> permeability_scale;  ///< per node: k/k0 of the last feedback (M24)
+    std::vector<char> well_shaped;     ///< per tet: dihedral angles of at least 2 degrees at rest
+    bool distorted = false;            ///< the last call left a distorted element: remesh before the next
+};
+
+/// Seconds spent per PFEM phase and what the calls did, summed over structures and calls
+/// (stats.json "phases" and "biot").
+struct PfemTimings {
+    Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0;
+    Index biot_calls = 0, biot_iterations = 0, remeshes = 0;
+    bool all_converged = true;
+};
+
+struct StructureState {
+    std::vector<Structure> structures;
+    // Per porous particle id (PorousParticles::id):
+    std::vector<Vec3> impulse;         ///< sum of force dt since the last call, N s
+    std::vector<Vec3> u;               ///< displacement carried over a remesh, m
+    std::vector<Vec3> rest_x;          ///< rest position X (world = body frame when anchored), m
+    std::vector<std::pair<Index, Index>> node_of;  ///< (structure, node), or (-1, -1)
+    std::vector<Mat3> rest_tensor;     ///< K0 in the body frame, m^2
+    std::vector<Real> paired_scale, paired_volume;  ///< k/k0 and V when the pore-flow pairs were built
+    Real elapsed = 0;                  ///< time since the last call, s
+    std::int64_t next_mesh_version = 0;
+    PfemTimings timings;
+    bool empty() const { return structures.empty(); }
+};
+
+/// Solvers of the structures' meshes. Copying a State copies no solver (the copy rebuilds
+/// them when it needs them), so a cache entry can always be dropped.
+class BiotCache {
+public:
+    struct Entry {
+        std::int64_t mesh_version = -1;
+        std::optional<BiotSolver> solver;
+        std::vector<Real> assembled_scale;  ///< per tet: the k/k0 the flow matrix was assembled with
+    };
+    BiotCache() = default;
+    BiotCache(const BiotCache&) {}
+    BiotCache& operator=(const BiotCache&) {
+        m_entries.clear();
+        return *this;
+    }
+    BiotCache(BiotCache&&) noexcept = default;
+    BiotCache& operator=(BiotCache&&) noexcept = default;
+
+    /// The entry of structure `slot`, or null when it was built on another mesh (or never).
+    Entry* find(size_t slot, std::int64_t mesh_version) {
+        if (slot >= m_entries.size() || m_entries[slot].mesh_version != mesh_version) return nullptr;
+        return &m_entries[slot];
+    }
+    Entry& reset(size_t slot) {
+        if (slot >= m_entries.size()) m_entries.resize(slot + 1);
+        m_entries[slot] = Entry{};
+        return m_entries[slot];
+    }
+
+private:
+    std::vector<Entry> m_entries;
+};
+
+}  // namespace karst
