@@ -171,5 +171,52 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     EXPECT_NEAR(mean, undrained, 0.05 * undrained) << "mean pore pressure in the middle, Pa";
 }
 
+
+TEST(CoupledStructure, AFragmentRestingOnAnAnchoredBlockLoadsItsBiotProblemThroughTheContacts) {
+    // A free impermeable block (8 kg) lies on an anchored soil block, with no water: the only
+    // load on the soil is the contact force, so the Biot call's mean load is the block's weight
+    // and the soil settles under it.
+    ThreadLimit one(1);
+    test::Simulation sim(R"({
+      "name": "pushed", "particle_spacing": 0.02, "time": { "fixed_dt": 0.002 },
+      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.4] } } ],
+      "porous_solids": [
+        { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.1] },
+          "material": { "porosity": 0.3, "permeability": 1e-10, "initial_saturation": 0, "youngs_modulus": 1e5, "poisson_ratio": 0.25 } },
+        { "shape": { "type": "box", "min": [0.1, 0.1, 0.1], "max": [0.3, 0.3, 0.2] }, "anchored": false,
+          "material": { "porosity": 0, "permeability": 1e-12, "solid_density": 2000 } } ],
+      "poroelastic": { "time_step": 0.02, "permeability_feedback": false }
+    })");
+    ASSERT_EQ(sim.state.structures.structures.size(), 1u);
+    const StructureState& st = sim.state.structures;
+    const Real weight = 9.81 * sim.state.porous.fragments[1].mass;
+    ASSERT_NEAR(weight, 9.81 * 8, 0.1);
+    Real load = 0;
+    int calls = 0;
+    while (sim.state.time < 1.0 - 1e-9) {
+        sim.advance();
+        // The loads the next call will take: the mean force since the last call, summed over the soil.
+        if (sim.state.time > 0.5 && st.elapsed > 0.017) {  // the last step before a call
+            Vec3 sum = Vec3::Zero();
+            for (Index id : st.structures[0].node_id) sum += st.impulse[id];
+            load -= sum[2] / st.elapsed, ++calls;
+        }
+    }
+    ASSERT_GE(calls, 20);
+    EXPECT_NEAR(load / calls, weight, 0.05 * weight) << "mean downward Biot load on the soil, N";
+    // The soil under the block settles; far from it, it hardly moves.
+    const Structure& s = st.structures[0];
+    Real under = 0, far = 0;
+    for (Index a = 0; a < s.mesh.node_count(); ++a) {
+        const Vec3& X = s.mesh.nodes[a];
+        if (X[2] < 0.08) continue;
+        if (std::max(std::abs(X[0] - 0.2), std::abs(X[1] - 0.2)) < 0.05) under = std::min(under, s.fields.u[a][2]);
+        if (std::max(std::abs(X[0] - 0.2), std::abs(X[1] - 0.2)) > 0.15) far = std::min(far, s.fields.u[a][2]);
+    }
+    // A 78 N load on 0.04 m^2 of a 0.1 m layer with E = 100 kPa: about 2 kPa over an oedometric modulus of 120 kPa, 1.6 mm.
+    EXPECT_LT(under, -5e-4) << "m";
+    EXPECT_GT(far, 0.5 * under) << "m";
+}
+
 }  // namespace
 }  // namespace karst
