@@ -333,3 +333,41 @@ TEST(Biot, AndersonMixingReachesTheFixedStressAnswerInFewerIterations) {
 
 }  // namespace
 }  // namespace karst
+
+namespace karst {
+namespace {
+
+TEST(Biot, AMeshWithEveryNodeFixedSolvesTheFlowAlone) {
+    // A thin layer between walls can have every node anchored: no elastic unknown is left, and
+    // the call is pure diffusion S dp/dt = div(k grad p) in a rigid skeleton. Column of height
+    // h drained at its top, p = 1 at t = 0: the series 4/pi sum (-1)^k/(2k+1) cos((2k+1) pi z /
+    // (2h)) exp(-(2k+1)^2 pi^2 c t / (4 h^2)) with c = k / S.
+    const Real h = 1, storage = 1e-3, mobility = 1e-3, c = mobility / storage;
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(0.5, 0.5, h), 0.125);
+    BiotProblem problem;
+    problem.material.storage = storage, problem.material.bulk_density = 0;
+    problem.mobility.assign(mesh.tet_count(), mobility * Mat3::Identity());
+    problem.fixed.assign(mesh.node_count(), FixAll);
+    problem.drained.assign(mesh.node_count(), 0);
+    for (Index a = 0; a < mesh.node_count(); ++a) problem.drained[a] = mesh.nodes[a][2] > h - 1e-9;
+    BiotSolver solver(mesh, problem);
+    EXPECT_EQ(solver.displacement_unknowns(), 0);
+    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 1)};
+    const Real t_end = 0.2 * h * h / c, dt = t_end / 100;
+    for (int k = 0; k < 100; ++k) solver.advance(dt, fields);
+    Real err2 = 0, ref2 = 0;
+    for (Index a = 0; a < mesh.node_count(); ++a) {
+        ASSERT_EQ(fields.u[a], Vec3::Zero());
+        Real exact = 0;
+        for (int k = 0; k < 100; ++k) {
+            const Real n = 2 * k + 1;
+            exact += (k % 2 ? -1 : 1) / n * std::cos(n * pi * mesh.nodes[a][2] / (2 * h)) * std::exp(-n * n * pi * pi * c * t_end / (4 * h * h));
+        }
+        exact *= 4 / pi;
+        err2 += std::pow(fields.p[a] - exact, 2), ref2 += exact * exact;
+    }
+    EXPECT_LT(std::sqrt(err2 / ref2), 0.01) << "L2 error of the pressure";
+}
+
+}  // namespace
+}  // namespace karst

@@ -221,12 +221,13 @@ struct BiotSolver::Impl {
         assemble_flow();
         t_assembly = watch.seconds();
         Stopwatch factor_watch;
-        KARST_CHECK(u_dofs.free_count > 0);
+        // A mesh whose every node is fixed (a thin layer between walls) has no elastic system:
+        // u stays prescribed and only the flow is solved.
         // A free body's six near-rigid modes (eps diag K) defeat CG: it stays direct.
         elastic_iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
         flow_iterative = options.linear_solver == LinearSolver::Amg ||
                          (options.linear_solver == LinearSolver::Auto && p_dofs.free_count >= options.amg_flow_unknowns);
-        elastic.compute(K_ff, elastic_iterative, elastic_iterative ? elastic_amg_options() : AmgOptions{});
+        if (u_dofs.free_count > 0) elastic.compute(K_ff, elastic_iterative, elastic_iterative ? elastic_amg_options() : AmgOptions{});
         t_elastic_factor = factor_watch.seconds();
     }
 
@@ -491,7 +492,7 @@ struct BiotSolver::Impl {
         // under steady loads), has that u as its predictor and skips the solve.
         const Vector rhs_predictor = u_dofs.gather_free(f_ext + Q * p) - elastic_lift;
         const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() && rhs_predictor == last_elastic_rhs && u == last_elastic_u;
-        if (!as_last_solve) u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u), ++report.elastic_solves;
+        if (!as_last_solve && u_dofs.free_count > 0) u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u), ++report.elastic_solves;
         // Anderson mixing of the pressure iterates [D] (beyond M22): it cut the fixed-stress
         // iterations per call from 4.2 to 3.4 in cave_soak and from 11.4 to 6.5 at tau = 5. The
         // fixed-strain order is left plain: it is kept to show the paper's divergence.
@@ -509,7 +510,7 @@ struct BiotSolver::Impl {
             // 2. Mechanics with p frozen: K u = f_ext + Q p.
             const Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
             Vector u_next = u;
-            u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
+            if (u_dofs.free_count > 0) u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
             last_elastic_rhs = rhs_u, last_elastic_u = u_next;
             ++report.elastic_solves;
             // 3. Changes relative to the change over the call [D]: M22 divides by |p^{k+1}|, but
