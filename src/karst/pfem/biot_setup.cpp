@@ -17,9 +17,10 @@ BiotOptions biot_options(const Model& model) {
     options.max_iterations = pe.max_iterations, options.tolerance = pe.tolerance;
     if (!pe.anderson) options.anderson_depth = 0;
     options.polyhedral = pe.mfem_polyhedra;
-    options.linear_solver = pe.linear_solver == "amg"      ? LinearSolver::Amg
-                            : pe.linear_solver == "direct" ? LinearSolver::Direct
-                                                           : LinearSolver::Auto;
+    using Choice = PoroelasticSettings::LinearSolver;
+    options.linear_solver = pe.linear_solver == Choice::Amg      ? LinearSolver::Amg
+                            : pe.linear_solver == Choice::Direct ? LinearSolver::Direct
+                                                                 : LinearSolver::Auto;
     return options;
 }
 

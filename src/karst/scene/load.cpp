@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <initializer_list>
+#include <stdexcept>
 #include <sstream>
 
 namespace karst {
@@ -15,6 +17,16 @@ namespace {
 using json = nlohmann::json;
 
 Vec3 vec3(const json& v) { return {v[0].get<Real>(), v[1].get<Real>(), v[2].get<Real>()}; }
+
+/// The value of an enum key (validated against the schema's options): every option must map to
+/// a value here, so an option added to the schema and forgotten here fails loudly.
+template <class T>
+T option(const json& v, std::initializer_list<std::pair<const char*, T>> options) {
+    const std::string name = v.get<std::string>();
+    for (const auto& [text, value] : options)
+        if (name == text) return value;
+    throw std::logic_error("scene reader: no value for the option '" + name + "'");
+}
 
 Shape read_shape(const json& j, const std::string& path) {
     Shape s;
@@ -74,7 +86,7 @@ Scene parse_scene(const std::string& text) {
     s.fluid.surface_tension = f["surface_tension"], s.fluid.adhesion = f["adhesion"];
     s.fluid.wall_friction = f["wall_friction"], s.fluid.sound_speed = f["sound_speed"];
     s.fluid.solute_diffusivity = f["solute_diffusivity"];
-    s.fluid.solver = f["solver"] == "pcisph" ? FluidSettings::Solver::Pcisph : FluidSettings::Solver::Dfsph;
+    s.fluid.solver = option<FluidSettings::Solver>(f["solver"], {{"dfsph", FluidSettings::Solver::Dfsph}, {"pcisph", FluidSettings::Solver::Pcisph}});
     s.fluid.max_density_error = f["max_density_error"];
     s.fluid.max_divergence_error = f["max_divergence_error"];
     s.fluid.min_iterations = f["min_iterations"], s.fluid.max_iterations = f["max_iterations"];
@@ -91,7 +103,7 @@ Scene parse_scene(const std::string& text) {
         const json& w = doc["walls"][i];
         const std::string path = fmt::format("/walls/{}", i);
         s.walls.push_back({read_shape(w["shape"], path + "/shape"),
-                           w["kind"] == "container" ? Wall::Kind::Container : Wall::Kind::Obstacle,
+                           option<Wall::Kind>(w["kind"], {{"container", Wall::Kind::Container}, {"obstacle", Wall::Kind::Obstacle}}),
                            w["layers"].get<int>(), path});
     }
     for (size_t i = 0; i < doc["porous_solids"].size(); ++i) {
@@ -111,9 +123,8 @@ Scene parse_scene(const std::string& text) {
         mat.initial_saturation = m["initial_saturation"];
         mat.dissolution_porosity = m["dissolution_porosity"], mat.dissolution_saturation = m["dissolution_saturation"];
         mat.absorption_factor = m["absorption_factor"];
-        const std::string layering = j["layering"]["kind"];
-        mat.layering = layering == "fibre" ? PorousMaterial::Layering::Fibre
-                     : layering == "from_geometry" ? PorousMaterial::Layering::FromGeometry : PorousMaterial::Layering::Bedding;
+        using Layering = PorousMaterial::Layering;
+        mat.layering = option<Layering>(j["layering"]["kind"], {{"bedding", Layering::Bedding}, {"fibre", Layering::Fibre}, {"from_geometry", Layering::FromGeometry}});
         solid.anchored = j["anchored"], solid.velocity = vec3(j["velocity"]), solid.angular_velocity = vec3(j["angular_velocity"]);
         mat.layering_normal = vec3(j["layering"]["normal"]), mat.layering_ratio = j["layering"]["ratio"];
         if (mat.layering_normal.norm() < 1e-6)
@@ -128,8 +139,7 @@ Scene parse_scene(const std::string& text) {
             const json& cj = j["constraints"][c];
             Constraint con;
             con.path = fmt::format("{}/constraints/{}", solid.path, c);
-            const std::string kind = cj["kind"];
-            con.kind = kind == "fixed" ? Constraint::Kind::Fixed : kind == "drained" ? Constraint::Kind::Drained : Constraint::Kind::Traction;
+            con.kind = option<Constraint::Kind>(cj["kind"], {{"fixed", Constraint::Kind::Fixed}, {"drained", Constraint::Kind::Drained}, {"traction", Constraint::Kind::Traction}});
             con.region = read_shape(cj["region"], con.path + "/region");
             const std::string axes = cj["axes"];
             con.axes = std::uint8_t((axes.find('x') != std::string::npos ? 1 : 0) | (axes.find('y') != std::string::npos ? 2 : 0) |
@@ -139,16 +149,17 @@ Scene parse_scene(const std::string& text) {
         }
         s.porous_solids.push_back(std::move(solid));
     }
-    s.paper_eq20 = doc["pore_flow"]["pair_flux"] == "paper_eq20";
+    s.paper_eq20 = option<bool>(doc["pore_flow"]["pair_flux"], {{"darcy", false}, {"paper_eq20", true}});
     const json& pe = doc["poroelastic"];
     s.poroelastic.time_step = pe["time_step"], s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
-    s.poroelastic.fixed_strain = pe["splitting"] == "fixed_strain";
-    s.poroelastic.pressure_from_pore_water = pe["pressure_source"] == "pore_water";
-    s.poroelastic.mfem_polyhedra = pe["shape_functions"] == "mfem_polyhedra";
-    s.poroelastic.linear_solver = pe["linear_solver"];
-    s.poroelastic.coupled_fragments = pe["coupled_fragments"] == "anchored";
+    s.poroelastic.fixed_strain = option<bool>(pe["splitting"], {{"fixed_stress", false}, {"fixed_strain", true}});
+    s.poroelastic.pressure_from_pore_water = option<bool>(pe["pressure_source"], {{"pore_water", true}, {"biot", false}});
+    s.poroelastic.mfem_polyhedra = option<bool>(pe["shape_functions"], {{"p1", false}, {"mfem_polyhedra", true}});
+    using Solver = PoroelasticSettings::LinearSolver;
+    s.poroelastic.linear_solver = option<Solver>(pe["linear_solver"], {{"auto", Solver::Auto}, {"direct", Solver::Direct}, {"amg", Solver::Amg}});
+    s.poroelastic.coupled_fragments = option<bool>(pe["coupled_fragments"], {{"anchored", true}, {"none", false}});
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
-    s.poroelastic.anderson = pe["acceleration"] == "anderson";
+    s.poroelastic.anderson = option<bool>(pe["acceleration"], {{"anderson", true}, {"none", false}});
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
     s.poroelastic.weighted_alpha = pe["weighted_alpha"];
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];
