@@ -52,21 +52,20 @@ DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::
             const bool last = k == pieces - 1;
             const Real mk = last ? mass_left : m / pieces, sk = last ? solute_left : solute / pieces;
             mass_left -= mk, solute_left -= sk;
-            fluid.x.push_back(porous.x[i] + (pieces > 1 ? piece_offset(k, settings.spacing) : Vec3::Zero()));
-            fluid.v.push_back(porous.v[i]);
-            fluid.mass.push_back(mk);
-            fluid.sph_mass.push_back(sph_mass * (mk / m));
-            fluid.solute.push_back(sk);
-            fluid.drained.push_back(0);
-            fluid.rho.push_back(law.rest_density);
-            fluid.p.push_back(0);
-            fluid.p_divergence.push_back(0);
-            fluid.id.push_back(next_id++);
+            const Index j = fluid.size();
+            resize_attributes(fluid, size_t(j) + 1);  // every attribute, zero unless set here
+            fluid.x[j] = porous.x[i] + (pieces > 1 ? piece_offset(k, settings.spacing) : Vec3::Zero());
+            fluid.v[j] = porous.v[i];
+            fluid.mass[j] = mk;
+            fluid.sph_mass[j] = sph_mass * (mk / m);
+            fluid.solute[j] = sk;
+            fluid.rho[j] = law.rest_density;
+            fluid.id[j] = next_id++;
             ++report.fluid_created;
         }
     }
     if (report.dissolved == 0) return report;
-    porous.keep(keep);
+    keep_attributes(porous, keep);
     return report;
 }
 

@@ -27,20 +27,11 @@ struct PorousParticles {
     std::vector<Index> id;             ///< stable over removals (the PFEM mesh's node -> particle map)
     Index size() const { return Index(x.size()); }
     Index material_of(Index i) const { return material.empty() ? 0 : material[i]; }
-    /// Appends the particles of `other`.
-    void append(const PorousParticles& other) {
-        auto add = [](auto& a, const auto& b) { a.insert(a.end(), b.begin(), b.end()); };
-        add(x, other.x), add(volume, other.volume), add(porosity, other.porosity), add(absorbed_mass, other.absorbed_mass);
-        add(solid_mass, other.solid_mass), add(v, other.v), add(permeability, other.permeability), add(fragment, other.fragment);
-        add(rest, other.rest), add(material, other.material), add(body_permeability, other.body_permeability);
-        add(id, other.id);
-    }
-    /// Keeps the particles whose flag is set, in order.
-    void keep(const std::vector<char>& flag) {
-        keep_flagged(x, flag), keep_flagged(volume, flag), keep_flagged(porosity, flag), keep_flagged(absorbed_mass, flag);
-        keep_flagged(solid_mass, flag), keep_flagged(v, flag), keep_flagged(permeability, flag), keep_flagged(fragment, flag);
-        keep_flagged(rest, flag), keep_flagged(material, flag), keep_flagged(body_permeability, flag);
-        keep_flagged(id, flag);
+    /// Calls f(a.attr, b.attr, ...) for every attribute of the sets (core/soa.hpp).
+    template <class F, class... Sets>
+    static void for_each_attribute(F&& f, Sets&... s) {
+        f(s.x...), f(s.volume...), f(s.porosity...), f(s.absorbed_mass...), f(s.solid_mass...), f(s.v...);
+        f(s.permeability...), f(s.fragment...), f(s.rest...), f(s.material...), f(s.body_permeability...), f(s.id...);
     }
 };
 

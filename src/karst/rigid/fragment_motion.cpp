@@ -78,7 +78,7 @@ void advance_fragments(const Model& model, State& state, Real dt) {
     const Index kept = std::count(inside.begin(), inside.end(), 1);
     if (kept != p.size()) {
         state.porous.removed += p.size() - kept;
-        p.keep(inside);
+        keep_attributes(p, inside);
         keep_flagged(s.exposed, inside);
         s.pairs_stale = true;
         refresh_fragment_mass(state, model.dx);

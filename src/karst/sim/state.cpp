@@ -7,30 +7,18 @@
 
 namespace karst {
 
-void FluidParticles::keep(const std::vector<char>& flag) {
-    keep_flagged(x, flag), keep_flagged(v, flag), keep_flagged(mass, flag), keep_flagged(solute, flag), keep_flagged(drained, flag);
-    keep_flagged(sph_mass, flag);
-    keep_flagged(rho, flag), keep_flagged(p, flag), keep_flagged(p_divergence, flag), keep_flagged(id, flag);
-}
-
-void FluidParticles::permute(const std::vector<std::uint32_t>& perm) {
-    apply_permutation(x, perm), apply_permutation(v, perm), apply_permutation(mass, perm), apply_permutation(solute, perm);
-    apply_permutation(drained, perm), apply_permutation(sph_mass, perm);
-    apply_permutation(rho, perm), apply_permutation(p, perm), apply_permutation(p_divergence, perm), apply_permutation(id, perm);
-}
-
 namespace {
 
 /// Porous particles of every solid (method.md §2) and one fragment per solid (§4.5), at rest or
 /// with a free solid's initial velocity and spin.
-void make_porous(const Model& model, PorousState& porous) {
+void make_porous(const Model& model, PorousState& porous, std::int64_t& next_id) {
     PorousParticles& p = porous.particles;
     for (const PorousBody& body : model.porous) {
         const PorousSolid& solid = model.scene.porous_solids[body.solid];
         const Index first = p.size(), fragment = Index(porous.fragments.size());
-        p.append(porous_particles_at_rest(model, body, fragment));
+        append_attributes(p, porous_particles_at_rest(model, body, fragment));
         const Index n = p.size() - first;
-        for (Index i = first; i < p.size(); ++i) p.id[i] = i;
+        for (Index i = first; i < p.size(); ++i) p.id[i] = next_id++;
         std::vector<Real> mass(n);
         for (Index i = 0; i < n; ++i) mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];
         std::vector<Vec3> rest;
@@ -50,21 +38,19 @@ void make_porous(const Model& model, PorousState& porous) {
 
 State make_initial_state(const Model& model) {
     State s;
+    // Porous particles take the first ids, so the structure side's per-id arrays stay short.
+    make_porous(model, s.porous, s.next_id);
     const size_t n = model.initial_x.size();
-    s.fluid.x = model.initial_x;
-    s.fluid.v = model.initial_v;
-    s.fluid.mass.assign(n, model.particle_mass);
-    s.fluid.solute.resize(n);
-    s.fluid.drained.assign(n, 0);
-    s.fluid.sph_mass = s.fluid.mass;
-    for (size_t i = 0; i < n; ++i) s.fluid.solute[i] = model.initial_concentration[i] * model.particle_mass;
-    s.fluid.rho.assign(n, model.rho0);
-    s.fluid.p.assign(n, 0);
-    s.fluid.p_divergence.assign(n, 0);
-    s.fluid.id.resize(n);
-    for (size_t i = 0; i < n; ++i) s.fluid.id[i] = std::int64_t(i);
-    s.next_id = std::int64_t(n);
-    make_porous(model, s.porous);
+    FluidParticles& f = s.fluid;
+    resize_attributes(f, n);
+    f.x = model.initial_x;
+    f.v = model.initial_v;
+    for (size_t i = 0; i < n; ++i) {
+        f.mass[i] = f.sph_mass[i] = model.particle_mass;
+        f.solute[i] = model.initial_concentration[i] * model.particle_mass;
+        f.rho[i] = model.rho0;
+        f.id[i] = s.next_id++;
+    }
     build_structures(model, s);
     return s;
 }

@@ -39,10 +39,12 @@ struct FluidParticles {
     Index size() const { return Index(x.size()); }
     /// The water particle i holds: m - m_sol - drained, kg.
     Real water(Index i) const { return mass[i] - solute[i] - drained[i]; }
-    /// Keeps the particles whose flag is true, in order.
-    void keep(const std::vector<char>& flag);
-    /// Reorders every attribute by perm (new k <- old perm[k]).
-    void permute(const std::vector<std::uint32_t>& perm);
+    /// Calls f(a.attr, b.attr, ...) for every attribute of the sets (core/soa.hpp).
+    template <class F, class... Sets>
+    static void for_each_attribute(F&& f, Sets&... s) {
+        f(s.x...), f(s.v...), f(s.mass...), f(s.sph_mass...), f(s.solute...), f(s.drained...), f(s.rho...), f(s.p...);
+        f(s.p_divergence...), f(s.id...);
+    }
 };
 
 /// Data rebuilt every step from the physical state.
@@ -113,7 +115,7 @@ struct State {
     Real dt_solver_limit = std::numeric_limits<Real>::infinity();
     Index removed = 0;            ///< particles that left the domain
     Index pushed_back = 0;        ///< fluid particles put back inside a wall they crossed (sph/integrate.hpp)
-    std::int64_t next_id = 0;
+    std::int64_t next_id = 0;     ///< the id of the next particle made, fluid or porous
 };
 
 /// Fluid at t = 0 from the model's sampled blocks; porous particles and their fragments at rest

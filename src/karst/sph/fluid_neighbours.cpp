@@ -4,7 +4,7 @@ namespace karst {
 
 void update_fluid_neighbours(const Model& model, State& state) {
     if (state.steps % model.scene.sort_interval == 0)
-        state.fluid.permute(morton_order(model.grid, state.fluid.x));
+        permute_attributes(state.fluid, morton_order(model.grid, state.fluid.x));
     FluidScratch& s = state.scratch;
     sort_into_cells(model.grid, state.fluid.x, s.cells);
     find_neighbours(model.grid, state.fluid.x, s.cells, true, s.fluid_fluid);

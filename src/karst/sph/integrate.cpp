@@ -66,7 +66,7 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
     const Index kept = std::count(keep.begin(), keep.end(), 1);
     if (kept != n) {
         for (Index e : escaped) state.removed += e;
-        f.keep(keep);
+        keep_attributes(f, keep);
     }
     return a_max;
 }

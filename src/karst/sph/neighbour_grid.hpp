@@ -59,12 +59,4 @@ void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
 /// Permutation sorting `x` along the Morton curve of their grid cells (ties by index).
 std::vector<std::uint32_t> morton_order(const UniformGrid& grid, const std::vector<Vec3>& x);
 
-/// Applies a permutation in place: a[k] <- a[perm[k]].
-template <class T>
-void apply_permutation(std::vector<T>& a, const std::vector<std::uint32_t>& perm) {
-    std::vector<T> tmp(a.size());
-    for (size_t k = 0; k < perm.size(); ++k) tmp[k] = a[perm[k]];
-    a.swap(tmp);
-}
-
 }  // namespace karst
