@@ -39,7 +39,7 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         points.add_scalar("density", fluid.rho);
         // The fluid's pressure: the density solve's plus, with DFSPH, the divergence solve's.
         std::vector<Real> pressure(fluid.size());
-        for (Index i = 0; i < fluid.size(); ++i) pressure[i] = fluid.p[i] + fluid.p_divergence[i];
+        for (Index i = 0; i < fluid.size(); ++i) pressure[i] = fluid.pressure(i);
         points.add_scalar("pressure", pressure);
         std::vector<Real> water(fluid.size());  // absorption drains it, dissolution brings grains
         for (Index i = 0; i < fluid.size(); ++i) water[i] = fluid.water(i);

@@ -9,12 +9,13 @@
 // below rho0, sits at p = 0 and is squeezed into its neighbours until the pressure spikes; in
 // a soaking block such particles in the gap beside the block reached 151 m/s within 0.6 s.
 #include "karst/porous/pore_water.hpp"
-#include "karst/sim/state.hpp"
+#include "karst/sph/fluid_particles.hpp"
+#include "karst/sph/neighbour_grid.hpp"
 
 namespace karst {
 
 /// For each fluid particle with water m - m_sol - drained below `threshold` m_f0 and a main receiver
-/// (PoreFlow's FluidExchange::main_receiver): its water goes to that porous particle, its solute
+/// (PoreFlowReport::main_receiver): its water goes to that porous particle, its solute
 /// (as mass and solute) to the nearest fluid neighbour in `fluid_fluid`, and its mass becomes 0
 /// so the integration stage drops it. A particle with solute and no fluid neighbour is kept.
 /// Returns the number of particles drained this way. Totals of water and solute are unchanged.

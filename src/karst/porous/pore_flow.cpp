@@ -116,14 +116,14 @@ PorePairs merge_pairs(const PorePairs& a, const PorePairs& b) {
 
 void PoreFlow::cache_fluid_conductances(const PorousParticles& p, const FluidExchange& fluid) {
     const Index n = p.size();
-    const int cap = fluid.porous_fluid->capacity;
+    const int cap = fluid.porous_fluid.capacity;
     m_fluid_conductance.resize(size_t(n) * cap);
     m_fluid_conductance_sum.resize(n);
     parallel_for(n, [&](Index i) {
         Real sum = 0;
         int s = 0;
-        fluid.porous_fluid->for_each(i, [&](Index f) {
-            const Real c = fluid_conductance(p, i, (*fluid.x)[f] - p.x[i], (*fluid.sph_mass)[f]);
+        fluid.porous_fluid.for_each(i, [&](Index f) {
+            const Real c = fluid_conductance(p, i, fluid.particles.x[f] - p.x[i], fluid.particles.sph_mass[f]);
             m_fluid_conductance[i * cap + s++] = c;
             sum += c;
         });
@@ -142,7 +142,7 @@ Real PoreFlow::pair_flux(Index i, Index j, Real conductance) const {
 }
 
 void PoreFlow::fluid_pair_fluxes(const PorousParticles& p, const FluidExchange& fluid) {
-    const NeighbourLists& lists = *fluid.porous_fluid;
+    const NeighbourLists& lists = fluid.porous_fluid;
     const int cap = lists.capacity;
     m_fluid_flux.resize(size_t(p.size()) * cap);
     parallel_for(p.size(), [&](Index k) {
@@ -222,26 +222,26 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neigh
 PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours, Real dt, FluidExchange* fluid) {
     PoreFlowReport report;
     const Index n = p.size();
-    const Index nf = fluid ? Index(fluid->mass->size()) : 0;
-    const int cap = fluid ? fluid->porous_fluid->capacity : 0;
+    const Index nf = fluid ? fluid->particles.size() : 0;
+    const int cap = fluid ? fluid->porous_fluid.capacity : 0;
     auto for_each_fluid_pair = [&](const auto& f) {  // serial, in (porous, slot) order: deterministic
         if (!fluid) return;
         for (Index k = 0; k < n; ++k)
-            for (int s = 0; s < fluid->porous_fluid->count[k]; ++s)
-                f(k, Index(fluid->porous_fluid->index[k * cap + s]), size_t(k * cap + s));
+            for (int s = 0; s < fluid->porous_fluid.count[k]; ++s)
+                f(k, Index(fluid->porous_fluid.index[k * cap + s]), size_t(k * cap + s));
     };
     // Positions, tensors and volumes hold for the whole step: the pair conductances are
     // computed once, and each sub-step only re-reads S and Phi. The kernel metric is needed
     // only where fluid partners are (the porous pairs came with their conductances).
     m_fluid_conductance_sum.assign(n, 0);
     if (fluid) {
-        refresh_metric(p, fluid->porous_fluid);
+        refresh_metric(p, &fluid->porous_fluid);
         cache_fluid_conductances(p, *fluid);
         // Phi_f = max(p, 0) - rho0 g.x (M6); the fluid pressure is this step's and stays fixed.
         m_fluid_potential.resize(nf);
         const PoreWaterLaw& l = m_laws[0];
         parallel_for(nf, [&](Index f) {
-            m_fluid_potential[f] = std::max((*fluid->pressure)[f], Real(0)) - l.rest_density * l.gravity.dot((*fluid->x)[f]);
+            m_fluid_potential[f] = std::max(fluid->particles.pressure(f), Real(0)) - l.rest_density * l.gravity.dot(fluid->particles.x[f]);
         });
         m_fluid_transfer.assign(size_t(n) * cap, 0);
     }
@@ -258,7 +258,7 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         // exactly; only the rows of wet particles and their partners are visited.
         m_wet.resize(n);
         std::fill(active.begin(), active.end(), 0);
-        for (Index i = 0; i < n; ++i) m_wet[i] = m_saturation[i] > 1e-6 || (fluid && fluid->porous_fluid->count[i] > 0);
+        for (Index i = 0; i < n; ++i) m_wet[i] = m_saturation[i] > 1e-6 || (fluid && fluid->porous_fluid.count[i] > 0);
         for (Index i = 0; i < n; ++i) {
             if (!m_wet[i]) continue;
             active[i] = 1;
@@ -303,7 +303,7 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
                 Real out = 0, sum = 0;
                 for_each_pair(p, neighbours, i, [&](Real q) { sum += q, out += std::max(-q, Real(0)); });
                 if (fluid)
-                    for (int s = 0; s < fluid->porous_fluid->count[i]; ++s) {
+                    for (int s = 0; s < fluid->porous_fluid.count[i]; ++s) {
                         const Real q = m_fluid_flux[i * cap + s];
                         sum += q, out += std::max(-q, Real(0));
                     }
@@ -326,8 +326,8 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
             }
         if (fluid) {
             for (Index f = 0; f < nf; ++f) {
-                const Real mass = (*fluid->mass)[f], drained = (*fluid->drained)[f];
-                const Real water = mass - (*fluid->solute)[f] - drained;
+                const Real mass = fluid->particles.mass[f], drained = fluid->particles.drained[f];
+                const Real water = mass - fluid->particles.solute[f] - drained;
                 const Real room = std::max(fluid->full_mass - mass + drained, Real(0));
                 if (fluid_out[f] * h_sub > water) {
                     m_fluid_donor_scale[f] = std::max(water, Real(0)) / (fluid_out[f] * h_sub);
@@ -341,9 +341,9 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         for (Index i = 0; i < n; ++i) p.absorbed_mass[i] = std::max(p.absorbed_mass[i] + h_sub * rate[i], Real(0));
         for_each_fluid_pair([&](Index, Index f, size_t slot) {
             const Real dm = h_sub * m_fluid_flux[slot];  // into the porous particle
-            Real& drained = (*fluid->drained)[f];
+            Real& drained = fluid->particles.drained[f];
             drained += dm;
-            if (drained < 0) (*fluid->mass)[f] -= drained, (*fluid->sph_mass)[f] -= drained, drained = 0;  // back-flow beyond what it gave
+            if (drained < 0) fluid->particles.mass[f] -= drained, fluid->particles.sph_mass[f] -= drained, drained = 0;  // back-flow beyond what it gave
             m_fluid_transfer[slot] += dm;
             report.absorbed += dm;
         });
@@ -353,10 +353,10 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
     }
     if (fluid) {
         // The porous particle that received most of each fluid particle's water (§4.7.3).
-        fluid->main_receiver.assign(nf, -1);
+        report.main_receiver.assign(nf, -1);
         std::vector<Real> most(nf, 0);
         for_each_fluid_pair([&](Index k, Index f, size_t slot) {
-            if (m_fluid_transfer[slot] > most[f]) most[f] = m_fluid_transfer[slot], fluid->main_receiver[f] = k;
+            if (m_fluid_transfer[slot] > most[f]) most[f] = m_fluid_transfer[slot], report.main_receiver[f] = k;
         });
     }
     return report;

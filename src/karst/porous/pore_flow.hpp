@@ -4,6 +4,7 @@
 // and fluid particles (absorption and back-flow, §4.7.3), with the donor limiter and sub-steps
 // of §4.7.5. Total water is conserved to round-off.
 #include "karst/porous/pore_water.hpp"
+#include "karst/sph/fluid_particles.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 
 #include <span>
@@ -14,24 +15,19 @@ struct PoreFlowReport {
     int substeps = 0;
     Index limited_donors = 0;  ///< donors whose outflow the limiter scaled (summed over sub-steps)
     Real absorbed = 0;         ///< net water from fluid into porous particles, kg
+    /// Per fluid particle: the porous particle that received most of its water in this step (-1
+    /// when none), for the deletion of drained particles. Empty without fluid.
+    std::vector<Index> main_receiver;
 };
 
 /// The fluid particles taking part in the pore flow (§4.7.3): each is a pore-water donor or
-/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6), volume m / rho0. A donor's water
+/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6, p the fluid's pressure()), volume m / rho0. A donor's water
 /// goes into `drained` (the SPH mass stays until the particle is deleted); water received
 /// first refills `drained`, then adds to the mass up to m_f0.
 struct FluidExchange {
-    const std::vector<Vec3>* x = nullptr;          ///< fluid positions, m
-    std::vector<Real>* mass = nullptr;             ///< fluid SPH masses m, kg (changed by back-flow)
-    std::vector<Real>* drained = nullptr;          ///< water already given, kg (changed)
-    std::vector<Real>* sph_mass = nullptr;         ///< rho0 V, kg (grows with the mass on back-flow)
-    const std::vector<Real>* solute = nullptr;     ///< solute masses, kg: water is m - m_sol - drained
-    const std::vector<Real>* pressure = nullptr;   ///< PCISPH pressure of this step, Pa
-    const NeighbourLists* porous_fluid = nullptr;  ///< per porous particle: its fluid partners
-    Real full_mass = 0;                            ///< m_f0: no transfer fills a fluid particle beyond it, kg
-    /// Out, per fluid particle: the porous particle that received most of its water this step
-    /// (-1 when none), for the deletion of drained particles.
-    std::vector<Index> main_receiver;
+    FluidParticles& particles;           ///< mass, sph_mass and drained change
+    const NeighbourLists& porous_fluid;  ///< per porous particle: its fluid partners
+    Real full_mass = 0;                  ///< m_f0: no transfer fills a fluid particle beyond it, kg
 };
 
 /// Porous pairs that exchange pore water with their conductances rho0 V_i V_j (k/eta)_ij F_ij

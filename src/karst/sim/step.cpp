@@ -53,13 +53,8 @@ auto timed(StepProfile& profile, Stage stage, const F& f) {
 /// flow among porous particles and with fluid particles, then the deletion of drained fluid.
 void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     PorousState& porous = state.porous;
-    FluidExchange fluid;
-    fluid.x = &state.fluid.x, fluid.mass = &state.fluid.mass, fluid.drained = &state.fluid.drained;
-    fluid.sph_mass = &state.fluid.sph_mass;
-    fluid.solute = &state.fluid.solute;
-    fluid.pressure = &state.fluid.p, fluid.porous_fluid = &state.porous_scratch.porous_fluid;
-    fluid.full_mass = model.particle_mass;
     PorousScratch& s = state.porous_scratch;
+    FluidExchange fluid{state.fluid, s.porous_fluid, model.particle_mass};
     if (!s.flow) s.flow.emplace(model.pore_laws, model.h, model.dx, model.scene.paper_eq20 ? PairFlux::PaperEq20 : PairFlux::Darcy);
     PoreFlow& flow = *s.flow;
     if (s.pairs_stale) {
@@ -79,7 +74,7 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
                 : flow.advance(porous.particles, s.fragment_pairs, dt, &fluid);
     porous.absorbed += report.absorbed;
     porous.pore_substeps += report.substeps;
-    porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, fluid.main_receiver,
+    porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, report.main_receiver,
                                                   state.scratch.fluid_fluid, model.particle_mass);
     // Which porous particles may dissolve later in the step, while the lists hold.
     mark_exposed(porous.particles, state.fluid, s.porous_fluid, model.h, model.dx, s.exposed);
