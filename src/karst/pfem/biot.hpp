@@ -50,17 +50,13 @@ struct BiotProblem {
 
 enum class Splitting { FixedStress, FixedStrain };
 
-/// How the elasticity and flow systems are solved. Measured on the 70,602-node benchmark
-/// (bench_pfem, 206,763 displacement and 68,921 pressure unknowns, 2 cores):
-///  - elasticity: CHOLMOD factorises in 16-18 s (7.6e11 flops) and then solves in 0.3 s;
-///    BoomerAMG sets up in 1.3 s but each warm-started CG solve takes 24-30 iterations of 0.1 s
-///    (hypre runs serially here, bound by memory bandwidth), so a call costs 13-17 s.
-///  - flow: CHOLMOD refactorises in 1.2 s (after a 1 s pattern analysis per mesh), BoomerAMG
-///    sets up in 0.1 s and solves in 14 iterations; the flow matrix changes with dt and with the
-///    mobility (every call under permeability feedback), so AMG wins on big meshes.
+/// How the elasticity and flow systems are solved. CHOLMOD factorises once per mesh and then
+/// solves cheaply; BoomerAMG sets up fast but each CG solve costs tens of iterations. The
+/// elasticity changes only with the mesh, so it is factorised; the flow matrix changes with dt
+/// and the mobility (every call under permeability feedback), so AMG wins for it on big meshes.
 /// Auto (the default) factorises the elasticity and picks the flow solver by size
 /// (BiotOptions::amg_flow_unknowns). Amg suits a mesh rebuilt at nearly every call, or one too
-/// big for the elastic factor's memory (1.8 GB at 70,000 nodes).
+/// big for the elastic factor's memory. Figures: bench/results/notes.md.
 enum class LinearSolver { Auto, Direct, Amg };
 
 struct BiotOptions {
@@ -74,8 +70,8 @@ struct BiotOptions {
     bool polyhedral = false;
     LinearSolver linear_solver = LinearSolver::Auto;
     Real amg_tolerance = 1e-8;  ///< CG residual, relative to that of its warm start
-    /// Auto: the flow goes to AMG from this many free pressure unknowns (the measured crossover
-    /// of a call that refactorises the flow, bench_pfem --edge).
+    /// Auto: the flow goes to AMG from this many free pressure unknowns (the crossover of a call
+    /// that refactorises the flow, bench_pfem --edge).
     Index amg_flow_unknowns = 30000;
 };
 

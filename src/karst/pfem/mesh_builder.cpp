@@ -3,8 +3,7 @@
 // Slivers (method.md §5.1.3) are dropped only where they touch the surface, as Kratos does
 // [D, deviation]: an interior sliver is typically the flat tet between two lattice cells whose
 // Delaunay split their shared square along different diagonals. Dropping it leaves the two
-// sides non-conforming, and the patch test then fails by 20 % of the displacement at a node
-// (measured, 1 x 0.6 x 0.8 box, dx = 0.2). Kept, the mesh is consistent but the sliver is stiff
+// sides non-conforming, and the patch test then fails at the nodes beside it. Kept, the mesh is consistent but the sliver is stiff
 // (~ area / thickness) and locks bending: a cantilever came out twice too stiff. So lattices
 // are meshed unjittered (box_nodes.hpp), where CGAL's symbolic perturbation splits the
 // cospherical cells consistently and no sliver arises; a sliver-free mesh of moved particles

@@ -226,18 +226,17 @@ std::vector<KeySpec> make_schema() {
             "cantilever: 0.4 % off Timoshenko against 5 % with p1 at the same nodes).",
             {"p1", "mfem_polyhedra"}),
         key("/poroelastic/linear_solver", T::Enum, "", any(), "auto",
-            "direct: CHOLMOD for both systems (on a 70,000-node block the elasticity factorises in "
-            "17 s, then solves in 0.3 s); amg: conjugate gradients with hypre's BoomerAMG for both "
-            "(1.3 s set-up, 2-3 s per elastic solve there), for meshes rebuilt at nearly every call "
-            "or too big for a factor's memory; auto: CHOLMOD for the elasticity and, from 30,000 "
-            "pressure unknowns, AMG for the flow, which is refactorised whenever dt or the "
-            "permeability changes (0.1 s set-up against 1.2 s).",
+            "direct: CHOLMOD for both systems (a slow factorisation per mesh, then fast solves); amg: "
+            "conjugate gradients with hypre's BoomerAMG for both (a fast set-up, slower solves), for "
+            "meshes rebuilt at nearly every call or too big for a factor's memory; auto: CHOLMOD for "
+            "the elasticity and, from 30,000 pressure unknowns, AMG for the flow, which is set up "
+            "again whenever dt or the permeability changes.",
             {"auto", "direct", "amg"}),
         key("/poroelastic/max_iterations", T::Integer, "", closed(1, 1000), 5, "k_max of M22."),
         key("/poroelastic/acceleration", T::Enum, "", any(), "anderson",
             "anderson: the fixed-stress pressure iterates are mixed over the last three (Anderson "
-            "acceleration; 3.4 instead of 4.2 iterations per call in cave_soak, 6.5 instead of 11.4 "
-            "at tau = 5); none: the plain M22 iteration. The fixed-strain order is never accelerated.",
+            "acceleration: fewer iterations per call, most where the coupling is strong); none: the "
+            "plain M22 iteration. The fixed-strain order is never accelerated.",
             {"anderson", "none"}),
         key("/poroelastic/tolerance", T::Number, "", closed(1e-14, 1), 1e-3,
             "Relative change of p and u that ends the iterations (M22)."),

@@ -14,11 +14,10 @@ namespace {
 ///
 /// Wall pressure [D]: method.md §4.3 writes the wall term with p_i alone; the variant it names,
 /// mirroring (p_ik = p_i), is needed because with p_i alone a wall-adjacent particle must carry
-/// twice the hydrostatic pressure (measured: 9970 Pa against 4807 Pa in the first layer). Plain
-/// mirroring still assumes a flat pressure inside the wall, so next to a side wall the particle
-/// loses the vertical gradient its missing fluid neighbours would have given: in a 10-particle
-/// wide column the z-gradient normalisation sum_j V_j x_ji,z dW/dz fell to 0.93 and the whole
-/// column settled 5 % over rho0 g depth. So the mirrored pressure is extrapolated
+/// about twice the hydrostatic pressure. Plain mirroring still assumes a flat pressure inside
+/// the wall, so next to a side wall the particle loses the vertical gradient its missing fluid
+/// neighbours would have given, and a narrow column settles over rho0 g depth. So the mirrored
+/// pressure is extrapolated
 /// hydrostatically, p_ik = max(p_i + rho0 g.(x_k - x_i), 0), after Band et al. 2018 ("Pressure
 /// boundaries for implicit incompressible SPH", their extrapolation without the acceleration
 /// term). The pair force stays equal and opposite, so the reaction on the wall is exact.
