@@ -10,7 +10,8 @@
 //   karst_bench_pfem [--repeats N] [--threads N] [--solver auto|direct|amg] [--edge L]
 //                    [--amg-flow-unknowns N]
 // --edge sets the block's side in m at spacing 0.1 m (default 4: 70,602 nodes), for the size
-// at which the flow system is better solved by AMG than by CHOLMOD (BiotOptions::amg_flow_unknowns).
+// at which the flow system is better solved by AMG than by CHOLMOD
+// (BiotOptions::amg_flow_unknowns).
 #include "provenance.hpp"
 
 #include "karst/core/parallel.hpp"
@@ -36,11 +37,16 @@ int main(int argc, char** argv) {
         return LinearSolver::Auto;
     };
     for (int a = 1; a + 1 < argc; a += 2) {
-        if (!std::strcmp(argv[a], "--repeats")) repeats = std::atoi(argv[a + 1]);
-        else if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
-        else if (!std::strcmp(argv[a], "--solver")) options.linear_solver = solver_named(argv[a + 1]);
-        else if (!std::strcmp(argv[a], "--edge")) edge = std::atof(argv[a + 1]);
-        else if (!std::strcmp(argv[a], "--amg-flow-unknowns")) options.amg_flow_unknowns = std::atol(argv[a + 1]);
+        if (!std::strcmp(argv[a], "--repeats"))
+            repeats = std::atoi(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--threads"))
+            threads = std::atoi(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--solver"))
+            options.linear_solver = solver_named(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--edge"))
+            edge = std::atof(argv[a + 1]);
+        else if (!std::strcmp(argv[a], "--amg-flow-unknowns"))
+            options.amg_flow_unknowns = std::atol(argv[a + 1]);
     }
     ThreadLimit limit(threads);
     const Real dx = 0.1;
@@ -73,13 +79,21 @@ int main(int argc, char** argv) {
         meshing_jittered = std::min(meshing_jittered, m.seconds());
     }
     const MeshQuality& q = mesh.quality;
-    fmt::print("karst_bench_pfem: {} nodes, {} threads\n", nodes.size(), ThreadLimit::active_threads());
+    fmt::print("karst_bench_pfem: {} nodes, {} threads\n", nodes.size(),
+               ThreadLimit::active_threads());
     fmt::print("  bare CGAL Delaunay      {:.3f} s ({} cells)\n", bare, cells);
-    fmt::print("  karst mesh build        {:.3f} s = {:.2f}x bare (goal <= 3x)\n", meshing, meshing / bare);
-    fmt::print("    elements {}, polyhedra {}, slivers dropped {}, interior slivers {}, min dihedral {:.1f} deg, volume {:.4f} m^3\n",
-               q.elements, q.polyhedra, q.slivers_dropped, q.interior_slivers, q.min_dihedral_deg, q.volume);
-    fmt::print("  jittered 1e-3 dx: bare {:.3f} s, karst {:.3f} s = {:.2f}x; {} elements, {} interior slivers, {} dropped\n",
-               bare_jittered, meshing_jittered, meshing_jittered / bare_jittered, jq.elements, jq.interior_slivers, jq.slivers_dropped);
+    fmt::print("  karst mesh build        {:.3f} s = {:.2f}x bare (goal <= 3x)\n", meshing,
+               meshing / bare);
+    fmt::print(
+        "    elements {}, polyhedra {}, slivers dropped {}, interior slivers {}, min dihedral "
+        "{:.1f} deg, volume {:.4f} m^3\n",
+        q.elements, q.polyhedra, q.slivers_dropped, q.interior_slivers, q.min_dihedral_deg,
+        q.volume);
+    fmt::print(
+        "  jittered 1e-3 dx: bare {:.3f} s, karst {:.3f} s = {:.2f}x; {} elements, {} interior "
+        "slivers, {} dropped\n",
+        bare_jittered, meshing_jittered, meshing_jittered / bare_jittered, jq.elements,
+        jq.interior_slivers, jq.slivers_dropped);
 
     // A sandstone block on anchored ground, drained on top, loaded by gravity and a 1 MPa traction.
     BiotProblem problem;
@@ -94,12 +108,14 @@ int main(int argc, char** argv) {
         if (mesh.nodes[a][2] == 0) problem.fixed[a] = FixAll;
         if (mesh.nodes[a][2] == hi[2]) problem.drained[a] = 1;
     }
-    problem.nodal_force = traction_loads(mesh, Vec3(0, 0, -1e6), [&](const Vec3& x) { return x[2] == hi[2]; });
+    problem.nodal_force =
+        traction_loads(mesh, Vec3(0, 0, -1e6), [&](const Vec3& x) { return x[2] == hi[2]; });
 
     Stopwatch setup;
     BiotSolver solver(mesh, problem, options);
     const Real t_setup = setup.seconds();
-    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
+    BiotFields fields{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()),
+                      std::vector<Real>(mesh.node_count(), 0)};
     const BiotCallReport first = solver.advance(10.0, fields);
     // The second call as in a coupled run: new loads (the traction 10 % up), so the predictor is
     // solved, and a new dt, so the flow system is refactorised.
@@ -110,23 +126,40 @@ int main(int argc, char** argv) {
     const Real first_call = t_setup + first.seconds_flow_factorisation + first.seconds_iterations;
     const Real later_call = second.seconds_flow_factorisation + second.seconds_iterations;
     const bool amg = solver.elastic_by_amg();
-    const std::string solvers = fmt::format("{}/{}", amg ? "amg" : "cholmod", solver.flow_by_amg() ? "amg" : "cholmod");
-    fmt::print("  Biot, {} displacement unknowns, {} nodes, elastic/flow solver {}:\n", solver.displacement_unknowns(), mesh.node_count(), solvers);
+    const std::string solvers =
+        fmt::format("{}/{}", amg ? "amg" : "cholmod", solver.flow_by_amg() ? "amg" : "cholmod");
+    fmt::print("  Biot, {} displacement unknowns, {} nodes, elastic/flow solver {}:\n",
+               solver.displacement_unknowns(), mesh.node_count(), solvers);
     fmt::print("    assembly                {:.3f} s\n", solver.seconds_assembly());
-    fmt::print("    elastic {}   {:.3f} s (once per mesh)\n", amg ? "AMG set-up    " : "factorisation", solver.seconds_elastic_factorisation());
-    fmt::print("    flow {}  {:.3f} s\n", solver.flow_by_amg() ? "AMG set-up    " : "factorisation ", first.seconds_flow_factorisation);
-    fmt::print("    iterations              {:.3f} s ({} iterations, converged {}; {} elastic solves; {} CG iterations)\n", first.seconds_iterations,
-               first.iterations, first.converged, first.elastic_solves, first.linear_iterations);
+    fmt::print("    elastic {}   {:.3f} s (once per mesh)\n",
+               amg ? "AMG set-up    " : "factorisation", solver.seconds_elastic_factorisation());
+    fmt::print("    flow {}  {:.3f} s\n",
+               solver.flow_by_amg() ? "AMG set-up    " : "factorisation ",
+               first.seconds_flow_factorisation);
+    fmt::print(
+        "    iterations              {:.3f} s ({} iterations, converged {}; {} elastic solves; {} "
+        "CG iterations)\n",
+        first.seconds_iterations, first.iterations, first.converged, first.elastic_solves,
+        first.linear_iterations);
     fmt::print("    first call              {:.3f} s (goal <= 2 s)\n", first_call);
-    fmt::print("    later call, same mesh   {:.3f} s ({} iterations, {} elastic solves; flow set-up {:.3f} s)\n", later_call, second.iterations,
-               second.elastic_solves, second.seconds_flow_factorisation);
+    fmt::print(
+        "    later call, same mesh   {:.3f} s ({} iterations, {} elastic solves; flow set-up "
+        "{:.3f} s)\n",
+        later_call, second.iterations, second.elastic_solves, second.seconds_flow_factorisation);
 
-    const auto file = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core" / "bench_pfem_70k.csv";
-    std::ofstream csv = bench::open_results(file, "solver,threads,nodes,elements,s_bare_delaunay,s_mesh,s_bare_delaunay_jittered,s_mesh_jittered,"
-                                                  "s_assembly,s_elastic_factor,s_flow_factor,s_iterations,iterations,s_first_call,s_later_call");
+    const auto file = std::filesystem::path(KARST_SOURCE_DIR) / "bench" / "results" / "2core" /
+                      "bench_pfem_70k.csv";
+    std::ofstream csv = bench::open_results(file,
+                                            "solver,threads,nodes,elements,s_bare_delaunay,s_mesh,"
+                                            "s_bare_delaunay_jittered,s_mesh_jittered,"
+                                            "s_assembly,s_elastic_factor,s_flow_factor,s_"
+                                            "iterations,iterations,s_first_call,s_later_call");
     csv << bench::provenance_fields(KARST_SOURCE_DIR);
-    csv << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f},{:.4f}\n", solvers, ThreadLimit::active_threads(), nodes.size(),
-                       q.elements, bare, meshing, bare_jittered, meshing_jittered, solver.seconds_assembly(), solver.seconds_elastic_factorisation(),
-                       first.seconds_flow_factorisation, first.seconds_iterations, first.iterations, first_call, later_call);
+    csv << fmt::format(
+        "{},{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.4f},{:.4f}\n",
+        solvers, ThreadLimit::active_threads(), nodes.size(), q.elements, bare, meshing,
+        bare_jittered, meshing_jittered, solver.seconds_assembly(),
+        solver.seconds_elastic_factorisation(), first.seconds_flow_factorisation,
+        first.seconds_iterations, first.iterations, first_call, later_call);
     fmt::print("  appended to {}\n", file.string());
 }

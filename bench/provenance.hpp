@@ -38,14 +38,16 @@ inline constexpr const char* k_provenance_columns = "date,commit,cores,cpu,";
 inline std::string provenance_fields(const std::string& source_dir) {
     const std::string git = "git -C '" + source_dir + "' ";
     std::string commit = first_line_of(git + "rev-parse --short=10 HEAD 2>/dev/null");
-    if (first_line_of(git + "status --porcelain --untracked-files=no 2>/dev/null") != "unknown") commit += "-dirty";
+    if (first_line_of(git + "status --porcelain --untracked-files=no 2>/dev/null") != "unknown")
+        commit += "-dirty";
     std::array<char, 32> date{};
     const std::time_t now = std::time(nullptr);
     std::strftime(date.data(), date.size(), "%Y-%m-%dT%H:%MZ", std::gmtime(&now));
     std::string cpu = cpu_model();
     for (char& c : cpu)
         if (c == ',') c = ' ';
-    return fmt::format("{},{},{},{},", date.data(), commit, std::thread::hardware_concurrency(), cpu);
+    return fmt::format("{},{},{},{},", date.data(), commit, std::thread::hardware_concurrency(),
+                       cpu);
 }
 
 /// `file` opened for appending, with `header` (provenance columns first) written when it is new.

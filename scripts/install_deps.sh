@@ -15,6 +15,7 @@ packages=(
     libfmt-dev libspdlog-dev # messages
     libgtest-dev             # tests (CTest)
     libbenchmark-dev         # micro benchmarks
+    clang-format git         # CI's layout check (.clang-format), benchmark provenance
 )
 
 missing=()

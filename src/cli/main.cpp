@@ -13,7 +13,8 @@
 namespace {
 
 karst::Scene read_scene(const std::string& path) {
-    return path.empty() ? karst::parse_scene(karst::default_scene_text()) : karst::load_scene_file(path);
+    return path.empty() ? karst::parse_scene(karst::default_scene_text())
+                        : karst::load_scene_file(path);
 }
 
 }  // namespace
@@ -27,7 +28,8 @@ int main(int argc, char** argv) {
     karst::RunOptions run_options;
     std::string out_dir;
     double end_time = -1, fps = -1;
-    CLI::App* run = app.add_subcommand("run", "Simulate a scene (the built-in dam break when none is given)");
+    CLI::App* run =
+        app.add_subcommand("run", "Simulate a scene (the built-in dam break when none is given)");
     run->add_option("scene", scene_path, "Scene file (JSON)");
     run->add_option("--out", out_dir, "Output folder (default out/<scene name>/)");
     run->add_option("--end-time", end_time, "Simulated end time in s (overrides /time/end)");
@@ -56,13 +58,16 @@ int main(int argc, char** argv) {
             const karst::Model model = karst::build_model(karst::load_scene_file(check_path));
             size_t porous = 0;
             for (const karst::PorousBody& body : model.porous) porous += body.rest_x.size();
-            fmt::print("scene '{}' is valid: {} fluid particles, {} porous particles in {} solids ({}), {} boundary particles, "
-                       "spacing {} m, domain [{}, {}, {}] - [{}, {}, {}] m\n",
-                       model.scene.name, model.initial_x.size(), porous, model.porous.size(),
-                       model.porous.empty() ? "none" : model.coupled() ? "coupled with the fluid" : "poroelastic-only",
-                       model.walls.size(), model.dx,
-                       model.domain.min[0], model.domain.min[1], model.domain.min[2],
-                       model.domain.max[0], model.domain.max[1], model.domain.max[2]);
+            fmt::print(
+                "scene '{}' is valid: {} fluid particles, {} porous particles in {} solids ({}), "
+                "{} boundary particles, "
+                "spacing {} m, domain [{}, {}, {}] - [{}, {}, {}] m\n",
+                model.scene.name, model.initial_x.size(), porous, model.porous.size(),
+                model.porous.empty() ? "none"
+                : model.coupled()    ? "coupled with the fluid"
+                                     : "poroelastic-only",
+                model.walls.size(), model.dx, model.domain.min[0], model.domain.min[1],
+                model.domain.min[2], model.domain.max[0], model.domain.max[1], model.domain.max[2]);
             return 0;
         }
         if (!out_dir.empty()) run_options.out_dir = out_dir;
@@ -70,12 +75,15 @@ int main(int argc, char** argv) {
         if (fps != -1) run_options.fps = fps;
         const karst::RunResult result = karst::run_simulation(read_scene(scene_path), run_options);
         if (!result.ok) {
-            fmt::print(stderr, "karst: {}\nkarst: the last good frame is in {}\n", result.failure, result.out_dir.string());
+            fmt::print(stderr, "karst: {}\nkarst: the last good frame is in {}\n", result.failure,
+                       result.out_dir.string());
             return 1;
         }
         if (!run_options.quiet)
-            fmt::print(stderr, "karst: done, {} frames in {} ({:.1f} s, {:.3f} MIPPS)\n", result.stats["frames"].get<int>(),
-                       result.out_dir.string(), result.stats["wall_time"].get<double>(), result.stats["mipps"].get<double>());
+            fmt::print(stderr, "karst: done, {} frames in {} ({:.1f} s, {:.3f} MIPPS)\n",
+                       result.stats["frames"].get<int>(), result.out_dir.string(),
+                       result.stats["wall_time"].get<double>(),
+                       result.stats["mipps"].get<double>());
         return 0;
     } catch (const karst::SceneError& e) {
         fmt::print(stderr, "karst: {}\n", e.what());

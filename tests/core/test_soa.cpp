@@ -30,7 +30,8 @@ TEST(ParticleAttributes, ResizeKeepPermuteAndAppendMoveEveryAttributeTogether) {
     ASSERT_TRUE(attributes_sized(f, 4));
     EXPECT_EQ(f.x[3], Vec3::Zero());
     EXPECT_EQ(f.p_divergence[3], 0);
-    for (Index i = 0; i < 4; ++i) f.id[i] = 10 + i, f.mass[i] = Real(i), f.x[i] = Vec3(Real(i), 0, 0);
+    for (Index i = 0; i < 4; ++i)
+        f.id[i] = 10 + i, f.mass[i] = Real(i), f.x[i] = Vec3(Real(i), 0, 0);
     keep_attributes(f, {1, 0, 1, 1});
     ASSERT_TRUE(attributes_sized(f, 3));
     EXPECT_EQ(f.id, (std::vector<std::int64_t>{10, 12, 13}));

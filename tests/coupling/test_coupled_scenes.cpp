@@ -25,7 +25,8 @@ Real free_surface(const Model& model, const FluidParticles& f, Real x, Real y, R
         if (std::abs(p[0] - x) < model.h && std::abs(p[1] - y) < model.h) column.push_back(p);
     auto colour = [&](Real z) {
         Real c = 0;
-        for (const Vec3& p : column) c += model.lattice_volume * model.kernel.w((Vec3(x, y, z) - p).norm());
+        for (const Vec3& p : column)
+            c += model.lattice_volume * model.kernel.w((Vec3(x, y, z) - p).norm());
         return c;
     };
     for (int it = 0; it < 40; ++it) (colour(0.5 * (lo + hi)) > 0.5 ? lo : hi) = 0.5 * (lo + hi);
@@ -65,7 +66,8 @@ TEST(Coupling, ImpermeableBoxFloatsAtTheArchimedesDraft) {
     const Real draft = draft_sum / samples;
     EXPECT_NEAR(draft, 0.06, 0.05 * 0.06) << "mean draft over 2-3 s, m";
     const Fragment& box = sim.state.porous.fragments[0];
-    EXPECT_LT((box.centre.head<2>() - Vec3(0.2, 0.2, 0).head<2>()).norm(), 0.5 * k_dx) << "it stays in the middle";
+    EXPECT_LT((box.centre.head<2>() - Vec3(0.2, 0.2, 0).head<2>()).norm(), 0.5 * k_dx)
+        << "it stays in the middle";
     EXPECT_EQ(sim.state.porous.absorbed, 0) << "an impermeable box takes no water";
 }
 
@@ -90,7 +92,8 @@ TEST(Coupling, LightPorousBoxSoaksUpWaterAndSinks) {
     Real absorbed = 0;
     for (Real m : sim.state.porous.particles.absorbed_mass) absorbed += m;
     EXPECT_GT(absorbed, 0.9 * capacity) << "kg";
-    EXPECT_LT(lowest(sim.state.porous.particles.x) - 0.5 * k_dx, k_dx) << "the box rests on the floor";
+    EXPECT_LT(lowest(sim.state.porous.particles.x) - 0.5 * k_dx, k_dx)
+        << "the box rests on the floor";
 }
 
 // No gravity, no fluid: a free fragment keeps its momentum, its angular momentum and its shape,
@@ -108,7 +111,8 @@ TEST(Coupling, FreeFragmentInVacuumConservesMomentumAndKeepsItsShape) {
     auto totals = [&] {
         const PorousParticles& p = sim.state.porous.particles;
         Vec3 momentum = Vec3::Zero();
-        for (Index k = 0; k < p.size(); ++k) momentum += (p.solid_mass[k] + p.absorbed_mass[k]) * p.v[k];
+        for (Index k = 0; k < p.size(); ++k)
+            momentum += (p.solid_mass[k] + p.absorbed_mass[k]) * p.v[k];
         const Fragment& f = sim.state.porous.fragments[0];
         return std::pair{momentum, Vec3(f.centre.cross(f.mass * f.velocity) + f.angular_momentum)};
     };
@@ -138,7 +142,8 @@ TEST(Coupling, FluidAndFragmentExchangeMomentumExactly) {
     })");
     auto momentum = [&] {
         Vec3 sum = Vec3::Zero();
-        for (Index i = 0; i < sim.state.fluid.size(); ++i) sum += sim.state.fluid.mass[i] * sim.state.fluid.v[i];
+        for (Index i = 0; i < sim.state.fluid.size(); ++i)
+            sum += sim.state.fluid.mass[i] * sim.state.fluid.v[i];
         for (const Fragment& f : sim.state.porous.fragments) sum += f.mass * f.velocity;
         return sum;
     };
@@ -162,7 +167,8 @@ TEST(Coupling, SoakKeepsWaterAndGrainsThroughAbsorptionDrainingAndDissolution) {
       "porous_solids": [ { "shape": { "type": "box", "min": [0.04, 0.04, 0], "max": [0.24, 0.24, 0.1] },
                            "material": { "porosity": 0.7 } } ],
       "output": { "fps": 5 }
-    })"), options);
+    })"),
+                                       options);
     ASSERT_TRUE(r.ok) << r.failure;
     const auto stats = nlohmann::json::parse(test::read_text(out / "stats.json"));
     const auto& mass = stats["mass"];
@@ -176,7 +182,8 @@ TEST(Coupling, SoakKeepsWaterAndGrainsThroughAbsorptionDrainingAndDissolution) {
     EXPECT_NEAR(grains1, grains0, 1e-12 * grains0);
     EXPECT_EQ(stats["counts"]["fragments"], 1);
     EXPECT_TRUE(std::filesystem::exists(out / "porous_0010.vtp"));
-    EXPECT_NE(test::read_text(out / "run.pvd").find("part=\"3\" file=\"porous_0010.vtp\""), std::string::npos);
+    EXPECT_NE(test::read_text(out / "run.pvd").find("part=\"3\" file=\"porous_0010.vtp\""),
+              std::string::npos);
     std::filesystem::remove_all(out);
 }
 

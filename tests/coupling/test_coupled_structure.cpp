@@ -29,7 +29,8 @@ std::string loaded_block_scene(Real youngs_modulus, const std::string& poroelast
   "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.06] },
                        "material": { "porosity": 0.3, "permeability": 1e-9, "initial_saturation": 1,
                                      "youngs_modulus": )" +
-           std::to_string(youngs_modulus) + R"(, "poisson_ratio": 0.25, "absorption_factor": 0.01 } } ],
+           std::to_string(youngs_modulus) +
+           R"(, "poisson_ratio": 0.25, "absorption_factor": 0.01 } } ],
   "poroelastic": { "time_step": 0.02, "permeability_feedback": false)" +
            poroelastic + R"( }
 })";
@@ -80,7 +81,8 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
     const Real load = run_and_mean_load(sim, 0.6, 1.0);
     // 1. The block carries the water's weight (less the little it absorbed): the loads are right.
     const Real water_weight = fluid_weight - g * sim.state.porous.absorbed;
-    EXPECT_NEAR(load, water_weight, 0.05 * water_weight) << "mean vertical fluid load over 0.6-1 s, N";
+    EXPECT_NEAR(load, water_weight, 0.05 * water_weight)
+        << "mean vertical fluid load over 0.6-1 s, N";
     EXPECT_EQ(sim.state.structures.timings.biot_calls, 50);
 
     // 2. Its top settles as a drained Biot solve of the same mesh under the same mean load as a
@@ -90,13 +92,16 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
     PfemTimings timings;
     const TetMesh mesh = mesh_points(sim.model, coupled.nodes.x, timings);
     ASSERT_EQ(mesh.node_count(), Index(coupled.nodes.x.size()));
-    BiotProblem reference = biot_problem(sim.model, sim.model.scene.porous_solids[0], mesh,
-                                         std::vector<Mat3>(mesh.node_count(), 1e-9 * Mat3::Identity()));
+    BiotProblem reference =
+        biot_problem(sim.model, sim.model.scene.porous_solids[0], mesh,
+                     std::vector<Mat3>(mesh.node_count(), 1e-9 * Mat3::Identity()));
     reference.gravity = Vec3::Zero();
     reference.drained.assign(mesh.node_count(), 1);
     const Real top = 0.05, q = load / (0.4 * 0.4);
-    reference.nodal_force = traction_loads(mesh, Vec3(0, 0, -q), [&](const Vec3& x) { return x[2] > top - 1e-9; });
-    BiotFields drained{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()), std::vector<Real>(mesh.node_count(), 0)};
+    reference.nodal_force =
+        traction_loads(mesh, Vec3(0, 0, -q), [&](const Vec3& x) { return x[2] > top - 1e-9; });
+    BiotFields drained{std::vector<Vec3>(mesh.node_count(), Vec3::Zero()),
+                       std::vector<Real>(mesh.node_count(), 0)};
     BiotSolver(mesh, reference).advance(1.0, drained);
     const PointArray& u = array(coupled.nodes, "displacement");
     Real coupled_top = 0, reference_top = 0;
@@ -110,11 +115,14 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
     // Measured 0.221 against 0.237 mm (7 % less; the mean load was 152 N against 157 N of water).
     // The rest: the boundary forces reach h = 2 dx, so the second particle layer takes part of
     // the load and less soil is compressed, and P^p > 0 where water pressed in pushes back.
-    EXPECT_NEAR(coupled_top, reference_top, 0.12 * std::abs(reference_top)) << "mean top settlement, m";
+    EXPECT_NEAR(coupled_top, reference_top, 0.12 * std::abs(reference_top))
+        << "mean top settlement, m";
 
     // 3. The particles follow: the top layer sits at X + u of the call before the last (they move
     //    toward the last call's u over the next interval), which the steady load leaves unchanged.
-    EXPECT_NEAR(mean_sinking(sim.state.porous.particles, rest, top - 1e-9), coupled_top, 0.03 * std::abs(coupled_top)) << "m";
+    EXPECT_NEAR(mean_sinking(sim.state.porous.particles, rest, top - 1e-9), coupled_top,
+                0.03 * std::abs(coupled_top))
+        << "m";
 }
 
 TEST(CoupledStructure, AJellySoftBlockDistortsItsMeshAndIsRemeshedOnItsDeformedShape) {
@@ -147,13 +155,15 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     // so reaching the 1e-3 test takes about 11 plain iterations, or 6.5 with Anderson mixing (the
     // default); M22's default of 5 leaves about 2e-2.
     ThreadLimit one(1);
-    test::Simulation sim(loaded_block_scene(1e5, R"(, "pressure_source": "biot", "max_iterations": 20)"));
+    test::Simulation sim(
+        loaded_block_scene(1e5, R"(, "pressure_source": "biot", "max_iterations": 20)"));
     const Real load = run_and_mean_load(sim, 0.5, 0.8);
     EXPECT_TRUE(sim.state.structures.timings.all_converged);
     const BiotMaterial m = biot_material(sim.model, sim.model.scene.porous_solids[0].material);
     const Real M = 1 / m.storage, E_oed = m.lame_lambda() + 2 * m.shear_modulus();
     const Real q = load / (0.4 * 0.4);
-    const Real undrained = m.biot_coefficient * M * q / (E_oed + m.biot_coefficient * m.biot_coefficient * M);
+    const Real undrained =
+        m.biot_coefficient * M * q / (E_oed + m.biot_coefficient * m.biot_coefficient * M);
     MeshFrame frame;
     append_structure_meshes(sim.model, sim.state, frame);
     // The middle of the block, a block height and more from the side walls, which anchor its
@@ -170,7 +180,6 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     ASSERT_GT(undrained, 100) << "Pa";
     EXPECT_NEAR(mean, undrained, 0.05 * undrained) << "mean pore pressure in the middle, Pa";
 }
-
 
 TEST(CoupledStructure, AFragmentRestingOnAnAnchoredBlockLoadsItsBiotProblemThroughTheContacts) {
     // A free impermeable block (8 kg) lies on an anchored soil block, with no water: the only
@@ -195,7 +204,8 @@ TEST(CoupledStructure, AFragmentRestingOnAnAnchoredBlockLoadsItsBiotProblemThrou
     int calls = 0;
     while (sim.state.time < 1.0 - 1e-9) {
         sim.advance();
-        // The loads the next call will take: the mean force since the last call, summed over the soil.
+        // The loads the next call will take: the mean force since the last call, summed over the
+        // soil.
         if (sim.state.time > 0.5 && st.elapsed > 0.017) {  // the last step before a call
             Vec3 sum = Vec3::Zero();
             for (Index id : st.structures[0].node_id) sum += st.impulse[id];
@@ -210,12 +220,40 @@ TEST(CoupledStructure, AFragmentRestingOnAnAnchoredBlockLoadsItsBiotProblemThrou
     for (Index a = 0; a < s.mesh.node_count(); ++a) {
         const Vec3& X = s.mesh.nodes[a];
         if (X[2] < 0.08) continue;
-        if (std::max(std::abs(X[0] - 0.2), std::abs(X[1] - 0.2)) < 0.05) under = std::min(under, s.fields.u[a][2]);
-        if (std::max(std::abs(X[0] - 0.2), std::abs(X[1] - 0.2)) > 0.15) far = std::min(far, s.fields.u[a][2]);
+        if (std::max(std::abs(X[0] - 0.2), std::abs(X[1] - 0.2)) < 0.05)
+            under = std::min(under, s.fields.u[a][2]);
+        if (std::max(std::abs(X[0] - 0.2), std::abs(X[1] - 0.2)) > 0.15)
+            far = std::min(far, s.fields.u[a][2]);
     }
-    // A 78 N load on 0.04 m^2 of a 0.1 m layer with E = 100 kPa: about 2 kPa over an oedometric modulus of 120 kPa, 1.6 mm.
+    // A 78 N load on 0.04 m^2 of a 0.1 m layer with E = 100 kPa: about 2 kPa over an oedometric
+    // modulus of 120 kPa, 1.6 mm.
     EXPECT_LT(under, -5e-4) << "m";
     EXPECT_GT(far, 0.5 * under) << "m";
+}
+
+TEST(CoupledStructure, ACopiedStateRebuildsItsBiotSolversAndContinuesIdentically) {
+    // The factorisations are a cache, not state: a copy of the State has none, rebuilds them from
+    // its meshes at its next call, and runs on bit for bit with the original.
+    ThreadLimit one(1);
+    test::Simulation sim(loaded_block_scene(1e5));
+    while (sim.state.time < 0.1 - 1e-9) step(sim.model, sim.state, 0.002, sim.profile);
+    State copy = sim.state;
+    const Index calls_before = sim.state.structures.timings.biot_calls;
+    ASSERT_GT(calls_before, 0);
+    const Structure& s = copy.structures.structures.at(0);
+    EXPECT_EQ(copy.biot_cache.find(0, s.mesh_version), nullptr) << "a copy holds no solver";
+    StepProfile profile;
+    while (sim.state.time < 0.2 - 1e-9) {
+        step(sim.model, sim.state, 0.002, sim.profile);
+        step(sim.model, copy, 0.002, profile);
+    }
+    EXPECT_NE(copy.biot_cache.find(0, s.mesh_version), nullptr) << "rebuilt at its first call";
+    EXPECT_EQ(copy.structures.timings.biot_calls, sim.state.structures.timings.biot_calls);
+    const Structure& a = sim.state.structures.structures.at(0);
+    EXPECT_EQ(a.fields.u, s.fields.u);
+    EXPECT_EQ(a.fields.p, s.fields.p);
+    EXPECT_EQ(sim.state.porous.particles.x, copy.porous.particles.x);
+    EXPECT_EQ(sim.state.fluid.x, copy.fluid.x);
 }
 
 }  // namespace

@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 using karst::test::read_text;
 
 int karst(const std::string& args) {
-    const int status = std::system((std::string(KARST_BINARY) + " " + args + " 2>/dev/null").c_str());
+    const int status =
+        std::system((std::string(KARST_BINARY) + " " + args + " 2>/dev/null").c_str());
     return WEXITSTATUS(status);
 }
 
@@ -31,7 +32,8 @@ const char* k_tiny = R"({
 
 struct TempDir {
     fs::path path;
-    explicit TempDir(const std::string& name) : path(fs::temp_directory_path() / ("karst_test_" + name)) {
+    explicit TempDir(const std::string& name)
+        : path(fs::temp_directory_path() / ("karst_test_" + name)) {
         fs::remove_all(path);
         fs::create_directories(path);
     }
@@ -42,7 +44,9 @@ TEST(Cli, WritesCompleteOutputFolder) {
     TempDir dir("cli");
     std::ofstream(dir.path / "tiny.json") << k_tiny;
     const fs::path out = dir.path / "out";
-    ASSERT_EQ(karst("run " + (dir.path / "tiny.json").string() + " --out " + out.string() + " --quiet --threads 1"), 0);
+    ASSERT_EQ(karst("run " + (dir.path / "tiny.json").string() + " --out " + out.string() +
+                    " --quiet --threads 1"),
+              0);
     // 0.1 s at 50 fps: frames 0..5.
     for (int f = 0; f <= 5; ++f) {
         char name[32];
@@ -51,18 +55,21 @@ TEST(Cli, WritesCompleteOutputFolder) {
         EXPECT_TRUE(fs::exists(out / (std::string(name) + ".ply"))) << name;
         const std::string vtp = read_text(out / (std::string(name) + ".vtp"));
         EXPECT_NE(vtp.find("<Verts>"), std::string::npos);
-        for (const char* array : {"velocity", "density", "pressure", "\"id\""}) EXPECT_NE(vtp.find(array), std::string::npos);
+        for (const char* array : {"velocity", "density", "pressure", "\"id\""})
+            EXPECT_NE(vtp.find(array), std::string::npos);
         EXPECT_TRUE(vtp.ends_with("</VTKFile>\n"));
     }
     EXPECT_FALSE(fs::exists(out / "fluid_0006.vtp"));
     EXPECT_TRUE(fs::exists(out / "boundary.vtp"));
-    for (const auto& e : fs::directory_iterator(out)) EXPECT_NE(e.path().extension(), ".tmp") << e.path();
+    for (const auto& e : fs::directory_iterator(out))
+        EXPECT_NE(e.path().extension(), ".tmp") << e.path();
 
     // run.pvd: every frame with its exact time, plus the boundary part.
     const std::string pvd = read_text(out / "run.pvd");
     const std::regex fluid_entry(R"re(timestep="([0-9.e-]+)" part="0" file="fluid_(\d{4}).vtp")re");
     int frames = 0;
-    for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), fluid_entry); it != std::sregex_iterator(); ++it, ++frames) {
+    for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), fluid_entry);
+         it != std::sregex_iterator(); ++it, ++frames) {
         EXPECT_EQ(std::stoi((*it)[2]), frames);
         EXPECT_NEAR(std::stod((*it)[1]), frames * 0.02, 1e-12);
     }
@@ -75,11 +82,13 @@ TEST(Cli, WritesCompleteOutputFolder) {
     for (const char* key : {"counts", "steps", "frames", "sim_time", "wall_time", "phases", "mass",
                             "max_density_error", "mipps", "threads", "version"})
         EXPECT_TRUE(stats.contains(key)) << key;
-    for (const char* key : {"fluid", "boundary", "porous", "elements", "fragments"}) EXPECT_TRUE(stats["counts"].contains(key));
+    for (const char* key : {"fluid", "boundary", "porous", "elements", "fragments"})
+        EXPECT_TRUE(stats["counts"].contains(key));
     EXPECT_EQ(stats["frames"], 6);
     EXPECT_EQ(stats["threads"], 1);
     EXPECT_NEAR(stats["sim_time"].get<double>(), 0.1, 1e-12);
-    EXPECT_DOUBLE_EQ(stats["mass"]["water_initial"].get<double>(), stats["mass"]["water_final"].get<double>());
+    EXPECT_DOUBLE_EQ(stats["mass"]["water_initial"].get<double>(),
+                     stats["mass"]["water_final"].get<double>());
     EXPECT_GT(stats["phases"]["pressure_solve"].get<double>(), 0);
 }
 
@@ -104,7 +113,8 @@ TEST(Cli, WatchdogStopsWithOneAfterWritingTheLastGoodFrame) {
     scene.replace(scene.find("\"output\""), 8, "\"watchdog\": { \"max_speed\": 0.3 }, \"output\"");
     std::ofstream(dir.path / "w.json") << scene;
     const fs::path out = dir.path / "out";
-    EXPECT_EQ(karst("run " + (dir.path / "w.json").string() + " --out " + out.string() + " --quiet"), 1);
+    EXPECT_EQ(
+        karst("run " + (dir.path / "w.json").string() + " --out " + out.string() + " --quiet"), 1);
     const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
     const std::string failure = stats["failure"];
     EXPECT_NE(failure.find("stage 'integrate'"), std::string::npos) << failure;

@@ -21,7 +21,8 @@ TEST(LaplaceShape, ReducesToBarycentricCoordinatesOnATet) {
         for (int a = 0; a < 4; ++a) x += (w[a] / sum) * tet[a];
         std::vector<Real> N(4);
         laplace_shape(tet, x, N);
-        for (int a = 0; a < 4; ++a) ASSERT_NEAR(N[a], w[a] / sum, 1e-12) << "trial " << trial << " node " << a;
+        for (int a = 0; a < 4; ++a)
+            ASSERT_NEAR(N[a], w[a] / sum, 1e-12) << "trial " << trial << " node " << a;
     }
 }
 
@@ -31,7 +32,9 @@ TEST(LaplaceShape, PartitionOfUnityAndLinearPrecisionOnAJitteredCube) {
     std::vector<Vec3> cube;
     for (int k = 0; k < 2; ++k)
         for (int j = 0; j < 2; ++j)
-            for (int i = 0; i < 2; ++i) cube.push_back(Vec3(i, j, k) + Vec3(jitter(random), jitter(random), jitter(random)));
+            for (int i = 0; i < 2; ++i)
+                cube.push_back(Vec3(i, j, k) +
+                               Vec3(jitter(random), jitter(random), jitter(random)));
     for (int trial = 0; trial < 20; ++trial) {
         const Vec3 x(inside(random), inside(random), inside(random));
         std::vector<Real> N(8);
@@ -42,7 +45,8 @@ TEST(LaplaceShape, PartitionOfUnityAndLinearPrecisionOnAJitteredCube) {
         Mat3 grad_x = Mat3::Zero();
         for (int a = 0; a < 8; ++a) {
             ASSERT_GE(N[a], 0);
-            sum += N[a], reproduced += N[a] * cube[a], grad_sum += grad[a], grad_x += cube[a] * grad[a].transpose();
+            sum += N[a], reproduced += N[a] * cube[a], grad_sum += grad[a],
+                grad_x += cube[a] * grad[a].transpose();
         }
         EXPECT_NEAR(sum, 1, 1e-12);
         EXPECT_LT((reproduced - x).norm(), 1e-12);

@@ -30,7 +30,8 @@ TEST(TetMesh, AlphaShapeOfJitteredLatticeCubeRecoversItsVolumeWithinOnePercent) 
     EXPECT_NEAR(assembled, 1.0, 0.01);
     // The boundary is closed and encloses the same volume (divergence theorem: V = 1/3 sum x.n dA).
     Real enclosed = 0;
-    for (const Triangle& t : mesh.boundary) enclosed += mesh.nodes[t[0]].dot(mesh.area_vector(t)) / 3;
+    for (const Triangle& t : mesh.boundary)
+        enclosed += mesh.nodes[t[0]].dot(mesh.area_vector(t)) / 3;
     EXPECT_NEAR(enclosed, mesh.quality.volume, 1e-9);
 }
 
@@ -63,7 +64,8 @@ TEST(TetMesh, JoiningGroupsTheCosphericalCornersOfEachLatticeCell) {
     }
     // Unjittered, CGAL splits each cell into 6 tets with one circumcentre and no sliver.
     const auto exact = box_lattice_nodes(Vec3::Zero(), Vec3::Ones(), dx);
-    const TetMesh lattice = build_tet_mesh(exact, std::vector<Real>(exact.size(), dx), MeshOptions{});
+    const TetMesh lattice =
+        build_tet_mesh(exact, std::vector<Real>(exact.size(), dx), MeshOptions{});
     EXPECT_EQ(lattice.quality.polyhedra, 1000);
     EXPECT_EQ(lattice.quality.elements, 6000);
     EXPECT_EQ(lattice.quality.interior_slivers + lattice.quality.slivers_dropped, 0);
@@ -84,7 +86,8 @@ TEST(TetMesh, NoSurfaceSliverEntersAssembly) {
         if (mesh.tet_volume(e) >= options.sliver_volume * dx * dx * dx) continue;
         ++interior_slivers;
         const Tet& t = mesh.tets[e];
-        ASSERT_FALSE(on_surface[t[0]] && on_surface[t[1]] && on_surface[t[2]] && on_surface[t[3]]) << "sliver " << e << " lies on the surface";
+        ASSERT_FALSE(on_surface[t[0]] && on_surface[t[1]] && on_surface[t[2]] && on_surface[t[3]])
+            << "sliver " << e << " lies on the surface";
     }
     EXPECT_EQ(interior_slivers, mesh.quality.interior_slivers);
     EXPECT_EQ(mesh.quality.elements + mesh.quality.slivers_dropped, mesh.quality.kept);

@@ -27,11 +27,13 @@ const std::string k_scene = std::string(KARST_SOURCE_DIR) + "/scenes/terzaghi_co
 /// Terzaghi's series (MOOSE terzaghi.i parameters: c_v = 13.95, p0 = 0.6977) for a column of
 /// height h: pressure at height z over the base.
 Real terzaghi_pressure(Real z, Real t, Real h) {
-    constexpr Real pi = std::numbers::pi, c_v = 1.5 / (0.0625 + 0.36 * 0.125), p0 = 0.6 * 0.125 / (0.0625 + 0.36 * 0.125);
+    constexpr Real pi = std::numbers::pi, c_v = 1.5 / (0.0625 + 0.36 * 0.125),
+                   p0 = 0.6 * 0.125 / (0.0625 + 0.36 * 0.125);
     Real p = 0;
     for (int k = 0; k < 200; ++k) {
         const Real n = 2 * k + 1;
-        p += (k % 2 ? -1 : 1) / n * std::cos(n * pi * z / (2 * h)) * std::exp(-n * n * pi * pi * c_v * t / (4 * h * h));
+        p += (k % 2 ? -1 : 1) / n * std::cos(n * pi * z / (2 * h)) *
+             std::exp(-n * n * pi * pi * c_v * t / (4 * h * h));
     }
     return 4 * p0 / pi * p;
 }
@@ -49,7 +51,8 @@ TEST(PoroelasticScene, ShippedTerzaghiSceneConsolidatesLikeTheSeries) {
         err2 += std::pow(s.fields.p[a] - exact, 2), ref2 += exact * exact;
     }
     EXPECT_LT(std::sqrt(err2 / ref2), 0.03) << "L2 error of the pore pressure over the column";
-    EXPECT_EQ(sim.state.structures.timings.biot_calls, std::lround(t_end / sim.model.scene.poroelastic.time_step));
+    EXPECT_EQ(sim.state.structures.timings.biot_calls,
+              std::lround(t_end / sim.model.scene.poroelastic.time_step));
 }
 
 TEST(PoroelasticScene, CompactionLowersPermeabilityByKozenyCarman) {
@@ -76,19 +79,23 @@ TEST(PoroelasticScene, CompactionLowersPermeabilityByKozenyCarman) {
     const Real eps_v = -1e5 / (m.lame_lambda() + 2 * m.shear_modulus());
     const Real k = kozeny_carman_permeability(1e-10, 0.3, dynamic_porosity(0.3, eps_v, 0, 1e30));
     ASSERT_LT(k, 0.9e-10) << "a 10 % compaction must close pores";
-    for (const Mat3& mobility : problem.mobility) ASSERT_NEAR(mobility(0, 0) * 0.1 / k, 1, 1e-6);  // eta = 0.1
+    for (const Mat3& mobility : problem.mobility)
+        ASSERT_NEAR(mobility(0, 0) * 0.1 / k, 1, 1e-6);  // eta = 0.1
 }
 
 TEST(PoroelasticScene, SoakSceneSpreadsAlongTheLayersAndKeepsItsWater) {
     // scenes/soak_layered_block.json: a wet ball in a block layered 4 : 1 (normal z).
-    test::Simulation sim(read_text(std::string(KARST_SOURCE_DIR) + "/scenes/soak_layered_block.json"));
+    test::Simulation sim(
+        read_text(std::string(KARST_SOURCE_DIR) + "/scenes/soak_layered_block.json"));
     auto moments = [&] {
         const PorousParticles& p = sim.state.porous.particles;
         Real total = 0;
         Vec3 mean = Vec3::Zero(), second = Vec3::Zero();
-        for (Index i = 0; i < p.size(); ++i) total += p.absorbed_mass[i], mean += p.absorbed_mass[i] * p.x[i];
+        for (Index i = 0; i < p.size(); ++i)
+            total += p.absorbed_mass[i], mean += p.absorbed_mass[i] * p.x[i];
         mean /= total;
-        for (Index i = 0; i < p.size(); ++i) second += p.absorbed_mass[i] * (p.x[i] - mean).cwiseAbs2();
+        for (Index i = 0; i < p.size(); ++i)
+            second += p.absorbed_mass[i] * (p.x[i] - mean).cwiseAbs2();
         return std::pair{total, Vec3(second / total)};
     };
     const auto [water0, var0] = moments();
@@ -98,7 +105,8 @@ TEST(PoroelasticScene, SoakSceneSpreadsAlongTheLayersAndKeepsItsWater) {
     EXPECT_NEAR(water1, water0, 1e-12 * water0) << "pore water is conserved";
     const Real along = 0.5 * (var1[0] - var0[0] + var1[1] - var0[1]), across = var1[2] - var0[2];
     EXPECT_GT(along, 0);
-    EXPECT_NEAR(along / across, 4, 1) << "the wet region spreads faster along the layers (k ratio 4; measured 4.16)";
+    EXPECT_NEAR(along / across, 4, 1)
+        << "the wet region spreads faster along the layers (k ratio 4; measured 4.16)";
 }
 
 TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
@@ -110,40 +118,55 @@ TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
         EXPECT_NE(at, std::string::npos) << from;
         return s.replace(at, from.size(), to);
     };
-    EXPECT_EQ(refuse(edit("\"poisson_ratio\"", "\"poison_ratio\"")).path, "/porous_solids/0/material/poison_ratio");
-    EXPECT_EQ(refuse(edit("\"kind\": \"drained\"", "\"kind\": \"drainde\"")).path, "/porous_solids/0/constraints/5/kind");
-    EXPECT_EQ(refuse(edit("\"biot_coefficient\": 0.6", "\"biot_coefficient\": 0.05")).path, "/porous_solids/0/material/biot_coefficient");
-    EXPECT_EQ(refuse(edit("\"axes\": \"x\"", "\"axes\": \"w\"")).path, "/porous_solids/0/constraints/0/axes");
-    EXPECT_EQ(refuse(edit("\"youngs_modulus\": 7.2", "\"youngs_modulus\": -7.2")).path, "/porous_solids/0/material/youngs_modulus");
+    EXPECT_EQ(refuse(edit("\"poisson_ratio\"", "\"poison_ratio\"")).path,
+              "/porous_solids/0/material/poison_ratio");
+    EXPECT_EQ(refuse(edit("\"kind\": \"drained\"", "\"kind\": \"drainde\"")).path,
+              "/porous_solids/0/constraints/5/kind");
+    EXPECT_EQ(refuse(edit("\"biot_coefficient\": 0.6", "\"biot_coefficient\": 0.05")).path,
+              "/porous_solids/0/material/biot_coefficient");
+    EXPECT_EQ(refuse(edit("\"axes\": \"x\"", "\"axes\": \"w\"")).path,
+              "/porous_solids/0/constraints/0/axes");
+    EXPECT_EQ(refuse(edit("\"youngs_modulus\": 7.2", "\"youngs_modulus\": -7.2")).path,
+              "/porous_solids/0/material/youngs_modulus");
     // Fluid inside a porous solid.
-    const SceneError overlap = refuse(edit("\"porous_solids\": [",
-        "\"fluid_blocks\": [ { \"shape\": { \"type\": \"box\", \"min\": [0, 0, 0], \"max\": [1, 1, 1] } } ], \"porous_solids\": ["));
+    const SceneError overlap =
+        refuse(edit("\"porous_solids\": [",
+                    "\"fluid_blocks\": [ { \"shape\": { \"type\": \"box\", \"min\": [0, 0, 0], "
+                    "\"max\": [1, 1, 1] } } ], \"porous_solids\": ["));
     EXPECT_EQ(overlap.path, "/porous_solids/0/shape");
     EXPECT_NE(overlap.found.find("/fluid_blocks/0"), std::string::npos);
 }
 
 TEST(PoroelasticScene, CliWritesMeshFramesListedInRunPvdAndStats) {
-    const std::filesystem::path out = std::filesystem::temp_directory_path() / "karst_test_poroelastic";
+    const std::filesystem::path out =
+        std::filesystem::temp_directory_path() / "karst_test_poroelastic";
     std::filesystem::remove_all(out);
-    const std::string command = std::string(KARST_BINARY) + " run " + k_scene + " --end-time 0.2 --fps 10 --quiet --out " + out.string();
+    const std::string command = std::string(KARST_BINARY) + " run " + k_scene +
+                                " --end-time 0.2 --fps 10 --quiet --out " + out.string();
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
-    for (int f = 0; f < 3; ++f) EXPECT_TRUE(std::filesystem::exists(out / fmt::format("mesh_{:04d}.vtu", f))) << f;
+    for (int f = 0; f < 3; ++f)
+        EXPECT_TRUE(std::filesystem::exists(out / fmt::format("mesh_{:04d}.vtu", f))) << f;
     EXPECT_FALSE(std::filesystem::exists(out / "mesh_0003.vtu"));
     const std::string pvd = read_text(out / "run.pvd");
-    for (int f = 0; f < 3; ++f) EXPECT_NE(pvd.find(fmt::format("part=\"2\" file=\"mesh_{:04d}.vtu\"", f)), std::string::npos);
+    for (int f = 0; f < 3; ++f)
+        EXPECT_NE(pvd.find(fmt::format("part=\"2\" file=\"mesh_{:04d}.vtu\"", f)),
+                  std::string::npos);
     const std::string vtu = read_text(out / "mesh_0002.vtu");
-    for (const char* array : {"displacement", "pore_pressure", "porosity", "permeability", "effective_stress", "principal_stress", "crack_candidate"})
+    for (const char* array : {"displacement", "pore_pressure", "porosity", "permeability",
+                              "effective_stress", "principal_stress", "crack_candidate"})
         EXPECT_NE(vtu.find(fmt::format("Name=\"{}\"", array)), std::string::npos) << array;
     EXPECT_NE(vtu.find("Name=\"types\""), std::string::npos);
     EXPECT_NE(pvd.find("part=\"3\" file=\"porous_0002.vtp\""), std::string::npos);
     const std::string vtp = read_text(out / "porous_0002.vtp");
-    for (const char* array : {"saturation", "porosity", "absorbed_mass", "pore_pressure", "pore_velocity", "fragment", "permeability"})
+    for (const char* array : {"saturation", "porosity", "absorbed_mass", "pore_pressure",
+                              "pore_velocity", "fragment", "permeability"})
         EXPECT_NE(vtp.find(fmt::format("Name=\"{}\"", array)), std::string::npos) << array;
     const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
     EXPECT_EQ(stats["counts"]["porous"], 640);
     EXPECT_GT(stats["counts"]["elements"].get<int>(), 1000);
     EXPECT_EQ(stats["counts"]["fragments"], 1);
-    for (const char* phase : {"meshing", "assembly", "factorisation", "iterations"}) EXPECT_TRUE(stats["phases"].contains(phase)) << phase;
+    for (const char* phase : {"meshing", "assembly", "factorisation", "iterations"})
+        EXPECT_TRUE(stats["phases"].contains(phase)) << phase;
     EXPECT_GT(stats["biot"]["iterations"].get<int>(), 0);
     std::filesystem::remove_all(out);
 }

@@ -17,7 +17,8 @@ namespace {
 /// (T, Z) rows of the measured surge front (a copy of shared/data's table, with its source notes).
 std::vector<std::pair<Real, Real>> martin_moyce() {
     std::vector<std::pair<Real, Real>> rows;
-    std::ifstream in(std::string(KARST_SOURCE_DIR) + "/tests/physics/martin_moyce_1952_surge_front.csv");
+    std::ifstream in(std::string(KARST_SOURCE_DIR) +
+                     "/tests/physics/martin_moyce_1952_surge_front.csv");
     std::string line;
     while (std::getline(in, line)) {
         if (line.empty() || line[0] == '#' || line[0] == 'T') continue;
@@ -34,7 +35,8 @@ void expect_surge_front_follows_martin_moyce(const std::string& solver) {
     const auto data = martin_moyce();
     ASSERT_EQ(data.size(), 15u);
     const Real a = 0.05715, g = 9.81;
-    nlohmann::json scene = nlohmann::json::parse(test::read_text(std::string(KARST_SOURCE_DIR) + "/scenes/martin_moyce_dam_break.json"));
+    nlohmann::json scene = nlohmann::json::parse(
+        test::read_text(std::string(KARST_SOURCE_DIR) + "/scenes/martin_moyce_dam_break.json"));
     scene["fluid"]["solver"] = solver;
     test::Simulation sim(scene.dump());
     const Real dx = sim.model.dx;

@@ -99,7 +99,8 @@ TEST(Determinism, ACoupledRunWithBiotCallsAndARemeshIsIdenticalOnOneAndTwoThread
     EXPECT_TRUE(same_bits(p.x, q.x));
     EXPECT_TRUE(same_bits(p.absorbed_mass, q.absorbed_mass));
     EXPECT_TRUE(same_bits(p.porosity, q.porosity));
-    const Structure &s = a.state.structures.structures.at(0), &r = b.state.structures.structures.at(0);
+    const Structure &s = a.state.structures.structures.at(0),
+                    &r = b.state.structures.structures.at(0);
     EXPECT_TRUE(same_bits(s.fields.u, r.fields.u));
     EXPECT_TRUE(same_bits(s.fields.p, r.fields.p));
     EXPECT_TRUE(same_bits(s.mesh.tets, r.mesh.tets));

@@ -31,7 +31,8 @@ Real free_surface_height(const Model& model, const FluidParticles& f) {
                 return c;
             };
             Real lo = 0.44, hi = 0.54;  // colour(lo) > 1/2 > colour(hi): bisect
-            for (int it = 0; it < 40; ++it) (colour(0.5 * (lo + hi)) > 0.5 ? lo : hi) = 0.5 * (lo + hi);
+            for (int it = 0; it < 40; ++it)
+                (colour(0.5 * (lo + hi)) > 0.5 ? lo : hi) = 0.5 * (lo + hi);
             sum += 0.5 * (lo + hi), ++lines;
         }
     return sum / lines;
@@ -48,34 +49,38 @@ struct SettledColumn {
 };
 
 SettledColumn settle_column(const std::string& solver) {
-        ThreadLimit one(1);  // physics tests run single-threaded (perf-facts: shared cores)
-        test::Simulation sim(R"({
+    ThreadLimit one(1);  // physics tests run single-threaded (perf-facts: shared cores)
+    test::Simulation sim(R"({
           "name": "hydrostatic", "particle_spacing": 0.02,
           "time": { "dt_max": 0.002 },
-          "fluid": { "viscosity": 0.002, "solver": ")" + solver + R"(" },
+          "fluid": { "viscosity": 0.002, "solver": ")" +
+                         solver + R"(" },
           "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.5] } } ],
           "walls": [ { "kind": "container", "layers": 2, "shape": { "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.7] } } ]
         })");
-        sim.run_until(2.0);
-        struct Sums { Real p = 0, z = 0; int n = 0; };
-        std::map<int, Sums> rows;
-        Real surface_sum = 0;
-        int samples = 0;
-        sim.run_until(2.2, [&] {
-            const FluidParticles& f = sim.state.fluid;
-            for (Index i = 0; i < f.size(); ++i) {
-                Sums& s = rows[int(std::floor(f.x[i][2] / k_dx))];
-                s.p += f.p[i] + f.p_divergence[i], s.z += f.x[i][2], ++s.n;
-            }
-            surface_sum += free_surface_height(sim.model, f), ++samples;
-        });
-        SettledColumn c;
-        for (const auto& [row, s] : rows) c.pressure[row] = s.p / s.n, c.height[row] = s.z / s.n;
-        c.surface = surface_sum / samples;
-        c.max_density_error = sim.max_density_error;
-        for (const Vec3& v : sim.state.fluid.v) c.rms_speed += v.squaredNorm();
-        c.rms_speed = std::sqrt(c.rms_speed / Real(sim.state.fluid.size()));
-        return c;
+    sim.run_until(2.0);
+    struct Sums {
+        Real p = 0, z = 0;
+        int n = 0;
+    };
+    std::map<int, Sums> rows;
+    Real surface_sum = 0;
+    int samples = 0;
+    sim.run_until(2.2, [&] {
+        const FluidParticles& f = sim.state.fluid;
+        for (Index i = 0; i < f.size(); ++i) {
+            Sums& s = rows[int(std::floor(f.x[i][2] / k_dx))];
+            s.p += f.p[i] + f.p_divergence[i], s.z += f.x[i][2], ++s.n;
+        }
+        surface_sum += free_surface_height(sim.model, f), ++samples;
+    });
+    SettledColumn c;
+    for (const auto& [row, s] : rows) c.pressure[row] = s.p / s.n, c.height[row] = s.z / s.n;
+    c.surface = surface_sum / samples;
+    c.max_density_error = sim.max_density_error;
+    for (const Vec3& v : sim.state.fluid.v) c.rms_speed += v.squaredNorm();
+    c.rms_speed = std::sqrt(c.rms_speed / Real(sim.state.fluid.size()));
+    return c;
 }
 
 /// The PCISPH column, whose rest pressure the tests below hold to 2 % per row.
@@ -115,7 +120,8 @@ TEST(Hydrostatic, PressureIsRho0GDepthWithinTwoPercentBelowTopTwoLayers) {
     for (int row = 0; row < 23; ++row) {
         const Real depth = c.surface - c.height.at(row), expected = k_rho0 * k_g * depth;
         EXPECT_NEAR(c.pressure.at(row), expected, 0.02 * scale)
-            << "row " << row << ": z " << c.height.at(row) << " m, depth " << depth << " m (surface at " << c.surface << " m)";
+            << "row " << row << ": z " << c.height.at(row) << " m, depth " << depth
+            << " m (surface at " << c.surface << " m)";
     }
 }
 
@@ -127,8 +133,9 @@ TEST(Hydrostatic, PressureWithinTwoPercentOfLocalRho0GDepthBelowTopFourLayers) {
     for (int row = 0; row < 21; ++row) {
         const Real depth = c.surface - c.height.at(row), expected = k_rho0 * k_g * depth;
         EXPECT_NEAR(c.pressure.at(row) / expected, 1.0, 0.02)
-            << "row " << row << ": z " << c.height.at(row) << " m, depth " << depth << " m, p " << c.pressure.at(row)
-            << " Pa, rho0 g depth " << expected << " Pa (surface at " << c.surface << " m)";
+            << "row " << row << ": z " << c.height.at(row) << " m, depth " << depth << " m, p "
+            << c.pressure.at(row) << " Pa, rho0 g depth " << expected << " Pa (surface at "
+            << c.surface << " m)";
     }
 }
 

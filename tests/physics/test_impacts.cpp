@@ -31,7 +31,8 @@ ImpactFigures drop(const std::string& scene, Real end) {
     sim.run_until(end, [&] {
         const Energy e = mechanical_energy(sim.model, sim.state);
         account.add(e);
-        if (account.released() > 0) r.worst_rise = std::max(r.worst_rise, (e.total() - e0) / account.released());
+        if (account.released() > 0)
+            r.worst_rise = std::max(r.worst_rise, (e.total() - e0) / account.released());
         r.fastest_p99 = std::max(r.fastest_p99, fluid_speed_p99_and_max(sim.state.fluid).first);
     });
     r.removed = sim.state.removed;
@@ -44,7 +45,8 @@ const std::vector<std::string> k_solvers{"dfsph", "pcisph"};
 /// An 8 x 8 x 8 block (dx 0.02) dropped 12 cm onto a flat floor; `fluid` adds /fluid keys,
 /// `time` /time keys.
 std::string block_on_floor(const std::string& fluid, const std::string& time) {
-    return R"({ "name": "drop", "particle_spacing": 0.02, "fluid": { )" + fluid + R"( }, "time": { )" + time + R"( },
+    return R"({ "name": "drop", "particle_spacing": 0.02, "fluid": { )" + fluid +
+           R"( }, "time": { )" + time + R"( },
       "fluid_blocks": [ { "shape": { "type": "box", "min": [0.32, 0.32, 0.12], "max": [0.48, 0.48, 0.28] } } ],
       "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.8, 0.8, 0.6] } } ] })";
 }
@@ -54,55 +56,63 @@ std::string block_on_floor(const std::string& fluid, const std::string& time) {
 TEST(Impacts, BlockDroppedOnAFloorGainsNoEnergy) {
     const Real H = 0.28, limit = 3 * std::sqrt(2 * 9.81 * H) + 1;
     for (const std::string& solver : k_solvers)
-      for (const auto& [tolerance, dt_max] : {std::pair{"0.01", "0.005"}, {"1e-5", "0.005"}, {"0.01", "0.001"}}) {
-        const std::string fluid = R"("solver": ")" + solver + R"(", "max_density_error": )" + tolerance;
-        const std::string settings = fluid + ", dt_max " + dt_max;
-        const ImpactFigures r = drop(block_on_floor(fluid, std::string(R"("dt_max": )") + dt_max), 0.8);
-        EXPECT_LE(r.worst_rise, 0.02) << settings;
-        EXPECT_LT(r.fastest_p99, limit) << settings;
-        EXPECT_GT(r.fastest_p99, 0.5 * std::sqrt(2 * 9.81 * 0.12)) << "the block must fall and splash";
-        EXPECT_EQ(r.particles_lost, 0) << settings;
-    }
+        for (const auto& [tolerance, dt_max] :
+             {std::pair{"0.01", "0.005"}, {"1e-5", "0.005"}, {"0.01", "0.001"}}) {
+            const std::string fluid =
+                R"("solver": ")" + solver + R"(", "max_density_error": )" + tolerance;
+            const std::string settings = fluid + ", dt_max " + dt_max;
+            const ImpactFigures r =
+                drop(block_on_floor(fluid, std::string(R"("dt_max": )") + dt_max), 0.8);
+            EXPECT_LE(r.worst_rise, 0.02) << settings;
+            EXPECT_LT(r.fastest_p99, limit) << settings;
+            EXPECT_GT(r.fastest_p99, 0.5 * std::sqrt(2 * 9.81 * 0.12))
+                << "the block must fall and splash";
+            EXPECT_EQ(r.particles_lost, 0) << settings;
+        }
 }
 
 /// A 10 x 10 x 8 block falling 0.4 m into a hemispherical bowl of radius 0.4 m.
 TEST(Impacts, BlockDroppedIntoABowlGainsNoEnergy) {
-  for (const std::string& solver : k_solvers)
-  for (const char* tolerance : {"0.01", "1e-5"}) {
-    SCOPED_TRACE(solver + " " + tolerance);
-    const ImpactFigures r = drop(R"({ "name": "bowl", "particle_spacing": 0.02,
-      "fluid": { "solver": ")" + solver + R"(", "max_density_error": )" + tolerance + R"( },
+    for (const std::string& solver : k_solvers)
+        for (const char* tolerance : {"0.01", "1e-5"}) {
+            SCOPED_TRACE(solver + " " + tolerance);
+            const ImpactFigures r = drop(R"({ "name": "bowl", "particle_spacing": 0.02,
+      "fluid": { "solver": ")" + solver + R"(", "max_density_error": )" +
+                                             tolerance + R"( },
       "fluid_blocks": [ { "shape": { "type": "box", "min": [0.3, 0.3, 0.40], "max": [0.5, 0.5, 0.56] } } ],
       "walls": [ { "kind": "container", "shape": { "type": "union", "shapes": [
          { "type": "sphere", "center": [0.4, 0.4, 0.4], "radius": 0.4 },
          { "type": "box", "min": [0.0, 0.0, 0.4], "max": [0.8, 0.8, 0.8] } ] } } ] })",
-                                 0.8);
-    EXPECT_LE(r.worst_rise, 0.02);
-    EXPECT_LT(r.fastest_p99, 3 * std::sqrt(2 * 9.81 * 0.56) + 1);
-    EXPECT_EQ(r.particles_lost, 0);
-  }
+                                         0.8);
+            EXPECT_LE(r.worst_rise, 0.02);
+            EXPECT_LT(r.fastest_p99, 3 * std::sqrt(2 * 9.81 * 0.56) + 1);
+            EXPECT_EQ(r.particles_lost, 0);
+        }
 }
 
 /// A 20 x 6 x 6 jet at 4 m/s against a side wall: the head of the limit is the jet's kinetic head
 /// plus its height, H = v^2 / 2g + z.
 TEST(Impacts, JetAgainstAWallGainsNoEnergy) {
-  for (const std::string& solver : k_solvers) {
-    SCOPED_TRACE(solver);
-    const ImpactFigures r = drop(R"({ "name": "jet", "particle_spacing": 0.02, "fluid": { "solver": ")" + solver + R"(" },
+    for (const std::string& solver : k_solvers) {
+        SCOPED_TRACE(solver);
+        const ImpactFigures r =
+            drop(R"({ "name": "jet", "particle_spacing": 0.02, "fluid": { "solver": ")" + solver +
+                     R"(" },
       "fluid_blocks": [ { "shape": { "type": "box", "min": [0.1, 0.3, 0.2], "max": [0.5, 0.42, 0.32] }, "velocity": [4, 0, 0] } ],
       "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [1.0, 0.8, 0.8] } } ] })",
-                                 0.5);
-    const Real H = 16.0 / (2 * 9.81) + 0.32;
-    EXPECT_LE(r.worst_rise, 0.02);
-    EXPECT_LT(r.fastest_p99, 3 * std::sqrt(2 * 9.81 * H) + 1);
-    EXPECT_EQ(r.particles_lost, 0);
-  }
+                 0.5);
+        const Real H = 16.0 / (2 * 9.81) + 0.32;
+        EXPECT_LE(r.worst_rise, 0.02);
+        EXPECT_LT(r.fastest_p99, 3 * std::sqrt(2 * 9.81 * H) + 1);
+        EXPECT_EQ(r.particles_lost, 0);
+    }
 }
 
 // A particle thrown at a wall with a step long enough to carry it through the wall skin is put
 // back inside, with no outward velocity, and counted; nothing is deleted.
 TEST(Impacts, AParticleThatCrossesAWallIsPutBackNotLost) {
-    test::Simulation sim(R"({ "name": "throw", "particle_spacing": 0.02, "time": { "fixed_dt": 0.01 },
+    test::Simulation sim(
+        R"({ "name": "throw", "particle_spacing": 0.02, "time": { "fixed_dt": 0.01 },
       "fluid_blocks": [ { "shape": { "type": "box", "min": [0.2, 0.2, 0.2], "max": [0.22, 0.22, 0.22] }, "velocity": [-30, 0, 0] } ],
       "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.4] } } ] })");
     sim.advance();

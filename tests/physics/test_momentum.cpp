@@ -21,7 +21,8 @@ TEST(Momentum, FreeBlobConservesLinearMomentum) {
     FluidParticles& f = sim.state.fluid;
     for (Index i = 0; i < f.size(); ++i) {
         const Vec3 x = f.x[i];
-        f.v[i] += Vec3(-x[1], x[0], 0) * 5.0 + x * -3.0 + Vec3(std::sin(40 * x[2]), 0, std::cos(30 * x[0])) * 0.1;
+        f.v[i] += Vec3(-x[1], x[0], 0) * 5.0 + x * -3.0 +
+                  Vec3(std::sin(40 * x[2]), 0, std::cos(30 * x[0])) * 0.1;
     }
     auto momentum = [&] {
         Vec3 p = Vec3::Zero();
@@ -38,7 +39,8 @@ TEST(Momentum, FreeBlobConservesLinearMomentum) {
     for (int k = 0; k < 60; ++k) sim.advance();
     EXPECT_EQ(sim.state.removed, 0);
     EXPECT_GT(sim.max_density_error, 0.0);  // the squeeze made the pressure solve work
-    EXPECT_LT((momentum() - p0).norm(), 1e-13 * s0) << "momentum drift " << (momentum() - p0).transpose();
+    EXPECT_LT((momentum() - p0).norm(), 1e-13 * s0)
+        << "momentum drift " << (momentum() - p0).transpose();
 }
 
 }  // namespace

@@ -12,7 +12,9 @@ namespace {
 
 TEST(LayeringFrame, WeightedPcaFindsTheNormalOfATiltedSlab) {
     const Real dx = 0.01, h = 2 * dx;
-    const Mat3 tilt = (Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized()) * Eigen::AngleAxisd(std::numbers::pi / 5, Vec3::UnitZ())).toRotationMatrix();
+    const Mat3 tilt = (Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized()) *
+                       Eigen::AngleAxisd(std::numbers::pi / 5, Vec3::UnitZ()))
+                          .toRotationMatrix();
     std::vector<Vec3> x;
     for (int k = 0; k < 3; ++k)  // a sheet three particles thick
         for (int j = 0; j < 30; ++j)
@@ -22,9 +24,11 @@ TEST(LayeringFrame, WeightedPcaFindsTheNormalOfATiltedSlab) {
     int checked = 0;
     for (size_t p = 0; p < x.size(); ++p) {
         const Vec3 local = (tilt.transpose() * x[p] / dx).array().round();  // lattice coordinates
-        if (local[0] < 5 || local[0] > 24 || local[1] < 5 || local[1] > 24) continue;  // away from the rim
+        if (local[0] < 5 || local[0] > 24 || local[1] < 5 || local[1] > 24)
+            continue;  // away from the rim
         ASSERT_TRUE(frames[p].reliable());
-        ASSERT_GT(std::abs(frames[p].normal().dot(normal)), std::cos(2 * std::numbers::pi / 180)) << "particle " << p;
+        ASSERT_GT(std::abs(frames[p].normal().dot(normal)), std::cos(2 * std::numbers::pi / 180))
+            << "particle " << p;
         ++checked;
     }
     EXPECT_EQ(checked, 3 * 20 * 20);

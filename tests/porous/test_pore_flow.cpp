@@ -14,7 +14,8 @@
 namespace karst {
 namespace {
 
-constexpr Real k_dx = 0.01, k_h = 2 * k_dx, k_phi = 0.3, k_k0 = 2e-8, k_eta = 0.1, k_capillary = 2000;
+constexpr Real k_dx = 0.01, k_h = 2 * k_dx, k_phi = 0.3, k_k0 = 2e-8, k_eta = 0.1,
+               k_capillary = 2000;
 
 struct Block {
     PorousParticles particles;
@@ -80,7 +81,8 @@ Mat3 pulse_moments(const PorousParticles& p) {
 }
 
 /// Growth of the pulse's variance along `axes` (columns) over `t`, divided by 2 D t there.
-Vec3 variance_growth_ratio(const Mat3& rotation, const Mat3& body_tensor, const Mat3& axes, Real t) {
+Vec3 variance_growth_ratio(const Mat3& rotation, const Mat3& body_tensor, const Mat3& axes,
+                           Real t) {
     ThreadLimit one(1);
     Block b = lattice_block(21, rotation, body_tensor);
     set_pulse(b.particles, 2.5 * k_dx);
@@ -88,7 +90,8 @@ Vec3 variance_growth_ratio(const Mat3& rotation, const Mat3& body_tensor, const 
     PoreFlow flow({linear_law()}, k_h, k_dx);
     flow.advance(b.particles, b.neighbours, t);
     const Mat3 after = pulse_moments(b.particles);
-    const Mat3 D = k_capillary * world_permeability(k_k0, k_k0, rotation, body_tensor) / (k_phi * k_eta);
+    const Mat3 D =
+        k_capillary * world_permeability(k_k0, k_k0, rotation, body_tensor) / (k_phi * k_eta);
     Vec3 ratio;
     for (int a = 0; a < 3; ++a) {
         const Vec3 e = axes.col(a);
@@ -99,14 +102,17 @@ Vec3 variance_growth_ratio(const Mat3& rotation, const Mat3& body_tensor, const 
 
 TEST(PoreFlow, IsotropicPulseSpreadsLikeTheAnalyticGaussian) {
     EXPECT_NEAR(pair_weight_calibration(), 1.046, 0.002);
-    const Vec3 r = variance_growth_ratio(Mat3::Identity(), k_k0 * Mat3::Identity(), Mat3::Identity(), 0.2);
+    const Vec3 r =
+        variance_growth_ratio(Mat3::Identity(), k_k0 * Mat3::Identity(), Mat3::Identity(), 0.2);
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(r[a], 1, 0.05) << "axis " << a;
 }
 
 TEST(PoreFlow, LayeredBlockSpreadsFourTimesFasterAlongTheLayersAtAnyOrientation) {
     const Mat3 K0 = layered_permeability(k_k0, Vec3::UnitZ(), 4);
     EXPECT_NEAR(mean_permeability(K0), k_k0, 1e-20);
-    const Mat3 turned = (Eigen::AngleAxisd(std::numbers::pi / 6, Vec3::UnitX()) * Eigen::AngleAxisd(std::numbers::pi / 4, Vec3::UnitY())).toRotationMatrix();
+    const Mat3 turned = (Eigen::AngleAxisd(std::numbers::pi / 6, Vec3::UnitX()) *
+                         Eigen::AngleAxisd(std::numbers::pi / 4, Vec3::UnitY()))
+                            .toRotationMatrix();
     for (const Mat3& R : {Mat3(Mat3::Identity()), turned}) {
         // Axes in the body frame: along the layers (x, y) and across (z), turned with the block.
         const Vec3 r = variance_growth_ratio(R, K0, R, 0.1);
@@ -114,7 +120,8 @@ TEST(PoreFlow, LayeredBlockSpreadsFourTimesFasterAlongTheLayersAtAnyOrientation)
         // Both directions follow their own D; hence the variance ratio is 4 within 10 %.
         EXPECT_NEAR(along, 1, 0.08);
         EXPECT_NEAR(r[2], 1, 0.08);
-        EXPECT_NEAR(along / r[2], 1, 0.10) << "variance growth along / across = " << 4 * along / r[2] << ", goal 4";
+        EXPECT_NEAR(along / r[2], 1, 0.10)
+            << "variance growth along / across = " << 4 * along / r[2] << ", goal 4";
     }
 }
 
@@ -124,9 +131,11 @@ TEST(PoreFlow, PoreWaterIsConservedToRoundOffWithTheLimiterAtWork) {
     Block b = lattice_block(14, Mat3::Identity(), layered_permeability(k_k0, Vec3(1, 1, 0), 4));
     PorousParticles& p = b.particles;
     for (Index i = 0; i < p.size(); ++i)
-        p.absorbed_mass[i] = p.x[i].cwiseAbs().maxCoeff() < 3 * k_dx ? 1.05 * 1000 * k_phi * p.volume[i] : 0;
+        p.absorbed_mass[i] =
+            p.x[i].cwiseAbs().maxCoeff() < 3 * k_dx ? 1.05 * 1000 * k_phi * p.volume[i] : 0;
     p.porosity[7] = 0;  // an impermeable particle takes no part
-    const Real before = deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
+    const Real before =
+        deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
     // beta = 0 (k_r = 1): dry particles above dry ones are donors with nothing to give, under
     // gravity, so the limiter must act for the masses to stay >= 0.
     PoreWaterLaw law;
@@ -137,7 +146,8 @@ TEST(PoreFlow, PoreWaterIsConservedToRoundOffWithTheLimiterAtWork) {
         const PoreFlowReport r = flow.advance(p, b.neighbours, 0.01);
         total.substeps += r.substeps, total.limited_donors += r.limited_donors;
     }
-    const Real after = deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
+    const Real after =
+        deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
     EXPECT_LT(std::abs(after - before) / before, 1e-12);
     for (Index i = 0; i < p.size(); ++i) ASSERT_GE(p.absorbed_mass[i], 0);
     EXPECT_EQ(p.absorbed_mass[7], 0);
@@ -145,7 +155,8 @@ TEST(PoreFlow, PoreWaterIsConservedToRoundOffWithTheLimiterAtWork) {
     EXPECT_GT(total.limited_donors, 0) << "the limiter was not exercised";
     // The wet core spread: particles outside it now hold water.
     Index wetted = 0;
-    for (Index i = 0; i < p.size(); ++i) wetted += p.x[i].cwiseAbs().maxCoeff() >= 3 * k_dx && p.absorbed_mass[i] > 0;
+    for (Index i = 0; i < p.size(); ++i)
+        wetted += p.x[i].cwiseAbs().maxCoeff() >= 3 * k_dx && p.absorbed_mass[i] > 0;
     EXPECT_GT(wetted, 100);
 }
 
@@ -163,7 +174,8 @@ Block column(int nx, int nz, Real permeability = k_k0) {
         for (int j = 0; j < nx; ++j)
             for (int i = 0; i < nx; ++i) {
                 p.x.push_back(k_dx * Vec3(i + 0.5, j + 0.5, k + 0.5));
-                p.volume.push_back(k_dx * k_dx * k_dx), p.porosity.push_back(k_phi), p.absorbed_mass.push_back(0);
+                p.volume.push_back(k_dx * k_dx * k_dx), p.porosity.push_back(k_phi),
+                    p.absorbed_mass.push_back(0);
                 p.permeability.push_back(permeability * Mat3::Identity()), p.fragment.push_back(0);
             }
     find_pairs(b);
@@ -184,7 +196,8 @@ TEST(PoreFlow, SaturatedColumnRelaxesToHydrostaticPorePressure) {
     std::vector<Real> pressure(nz, 0);
     for (Index i = 0; i < p.size(); ++i) {
         const int layer = int(p.x[i][2] / k_dx);
-        pressure[layer] += law.pore_pressure(law.saturation(p.absorbed_mass[i], k_phi, p.volume[i])) / 16;
+        pressure[layer] +=
+            law.pore_pressure(law.saturation(p.absorbed_mass[i], k_phi, p.volume[i])) / 16;
     }
     // Least-squares slope over the layers 2 .. nz - 4 (away from the base and the top).
     Real sz = 0, sp = 0, szz = 0, szp = 0;
@@ -237,7 +250,8 @@ TEST(PoreFlow, CapillaryWettingFrontAdvancesLikeSquareRootOfTime) {
         sx += x, sy += y, sxx += x * x, sxy += x * y;
     }
     const Real m = Real(times.size()), n = (m * sxy - sx * sy) / (m * sxx - sx * sx);
-    EXPECT_NEAR(n, 0.5, 0.1) << "fronts " << fronts[0] << " " << fronts[1] << " " << fronts[2] << " " << fronts[3] << " m";
+    EXPECT_NEAR(n, 0.5, 0.1) << "fronts " << fronts[0] << " " << fronts[1] << " " << fronts[2]
+                             << " " << fronts[3] << " m";
 }
 
 // The paper's Eq. 20 in its conservative form (method.md §9 item 7, /pore_flow/pair_flux):
@@ -255,23 +269,27 @@ TEST(PoreFlow, PaperEq20KeepsWaterButIgnoresGravityUnlikeDarcy) {
         PoreFlow flow({law}, k_h, k_dx, flux);
         for (int step = 0; step < 20; ++step) flow.advance(p, b.neighbours, 0.025);
         Real m = 0, z = 0;
-        for (Index i = 0; i < p.size(); ++i) m += p.absorbed_mass[i], z += p.absorbed_mass[i] * p.x[i][2];
+        for (Index i = 0; i < p.size(); ++i)
+            m += p.absorbed_mass[i], z += p.absorbed_mass[i] * p.x[i][2];
         return std::tuple{p.absorbed_mass, z / m};
     };
     std::vector<Real> before;
     const auto [darcy_mass, darcy_z] = uniform_block(PairFlux::Darcy, before);
     EXPECT_LT(darcy_z, -0.1 * k_dx) << "m: M15 lets the water sink (centre of the block at 0)";
     const auto [paper_mass, paper_z] = uniform_block(PairFlux::PaperEq20, before);
-    for (size_t i = 0; i < before.size(); ++i) ASSERT_NEAR(paper_mass[i], before[i], 1e-12 * before[i]) << "Eq. 20 moves nothing";
+    for (size_t i = 0; i < before.size(); ++i)
+        ASSERT_NEAR(paper_mass[i], before[i], 1e-12 * before[i]) << "Eq. 20 moves nothing";
 
     // Without gravity, a wet ball in a dry block spreads and keeps its water.
     law.gravity = Vec3::Zero();
     Block b = lattice_block(13, Mat3::Identity(), Mat3::Identity() * k_k0);
     PorousParticles& p = b.particles;
-    for (Index i = 0; i < p.size(); ++i) p.absorbed_mass[i] = (p.x[i].norm() < 2.6 * k_dx ? 1000 * k_phi * p.volume[i] : 0);
+    for (Index i = 0; i < p.size(); ++i)
+        p.absorbed_mass[i] = (p.x[i].norm() < 2.6 * k_dx ? 1000 * k_phi * p.volume[i] : 0);
     auto moments = [&] {
         Real m = 0, r2 = 0;
-        for (Index i = 0; i < p.size(); ++i) m += p.absorbed_mass[i], r2 += p.absorbed_mass[i] * p.x[i].squaredNorm();
+        for (Index i = 0; i < p.size(); ++i)
+            m += p.absorbed_mass[i], r2 += p.absorbed_mass[i] * p.x[i].squaredNorm();
         return std::pair{m, r2 / m};
     };
     const auto [m0, spread0] = moments();

@@ -45,7 +45,8 @@ TEST(Contact, HeadOnCollisionConservesMomentumAndRebounds) {
 TEST(Contact, NoForceWithinOneFragment) {
     Collision c(0.5 * 0.02, 1.0, 0);
     std::vector<Vec3> force(2, Vec3::Zero());
-    EXPECT_EQ(add_contact_forces(c.p, c.pairs, ContactLaw::for_fragments(0.02, 1, 9.81, c.m), force), 0);
+    EXPECT_EQ(
+        add_contact_forces(c.p, c.pairs, ContactLaw::for_fragments(0.02, 1, 9.81, c.m), force), 0);
     EXPECT_EQ(force[0], Vec3::Zero());
 }
 

@@ -8,7 +8,8 @@ namespace karst {
 namespace {
 
 TEST(Fragment, MassPropertiesOfALatticeBoxMatchTheClosedForm) {
-    // n_x x n_y x n_z particles of mass m at spacing d: I_xx = m N d^2 ((n_y^2 - 1) + (n_z^2 - 1)) / 12.
+    // n_x x n_y x n_z particles of mass m at spacing d: I_xx = m N d^2 ((n_y^2 - 1) + (n_z^2 - 1))
+    // / 12.
     const int nx = 6, ny = 4, nz = 3;
     const Real d = 0.1, m = 2.0;
     std::vector<Vec3> x;
@@ -49,7 +50,8 @@ TEST(Fragment, FreeFragmentInVacuumKeepsMomentaAndAUnitQuaternion) {
     // Kinetic energy of rotation 1/2 L.omega stays within 1 % over 20 s of tumbling.
     Fragment start;
     start.body_inertia = f.body_inertia, start.angular_momentum = L0;
-    const Real e0 = 0.5 * L0.dot(start.angular_velocity()), e1 = 0.5 * f.angular_momentum.dot(f.angular_velocity());
+    const Real e0 = 0.5 * L0.dot(start.angular_velocity()),
+               e1 = 0.5 * f.angular_momentum.dot(f.angular_velocity());
     EXPECT_NEAR(e1 / e0, 1, 0.01);
 }
 

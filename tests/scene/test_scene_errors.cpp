@@ -22,7 +22,9 @@ const char* k_valid = R"({
   "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.5, 0.5, 0.5] } } ]
 })";
 
-SceneError refuse(const std::string& json) { return test::refuse_scene(json); }
+SceneError refuse(const std::string& json) {
+    return test::refuse_scene(json);
+}
 
 std::string replace(std::string s, const std::string& from, const std::string& to) {
     const auto at = s.find(from);
@@ -46,31 +48,39 @@ TEST(SceneErrors, MisspeltKeyIsNamedWithSuggestion) {
 }
 
 TEST(SceneErrors, UnknownNestedKey) {
-    const SceneError e = refuse(replace(k_valid, "\"kind\": \"container\"", "\"kind\": \"container\", \"colour\": 3"));
+    const SceneError e = refuse(
+        replace(k_valid, "\"kind\": \"container\"", "\"kind\": \"container\", \"colour\": 3"));
     EXPECT_EQ(e.path, "/walls/0/colour");
 }
 
 TEST(SceneErrors, WrongType) {
-    const SceneError e = refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": \"fine\""));
+    const SceneError e =
+        refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": \"fine\""));
     EXPECT_EQ(e.path, "/particle_spacing");
     EXPECT_NE(e.expected.find("number"), std::string::npos);
     EXPECT_NE(e.found.find("string"), std::string::npos);
-    const SceneError v = refuse(replace(k_valid, "\"min\": [0, 0, 0], \"max\": [0.2", "\"min\": [0, 0], \"max\": [0.2"));
+    const SceneError v = refuse(
+        replace(k_valid, "\"min\": [0, 0, 0], \"max\": [0.2", "\"min\": [0, 0], \"max\": [0.2"));
     EXPECT_EQ(v.path, "/fluid_blocks/0/shape/min");
 }
 
 TEST(SceneErrors, OutOfRange) {
-    const SceneError e = refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": 0.05, \"fluid\": {\"viscosity\": -1}"));
+    const SceneError e =
+        refuse(replace(k_valid, "\"particle_spacing\": 0.05",
+                       "\"particle_spacing\": 0.05, \"fluid\": {\"viscosity\": -1}"));
     EXPECT_EQ(e.path, "/fluid/viscosity");
     EXPECT_NE(e.expected.find("m^2/s"), std::string::npos);
     EXPECT_EQ(e.found, "-1");
-    const SceneError s = refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": 0"));
+    const SceneError s =
+        refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": 0"));
     EXPECT_EQ(s.path, "/particle_spacing");
 }
 
 TEST(SceneErrors, MissingRequiredKeyAndBadEnum) {
     EXPECT_EQ(refuse(replace(k_valid, "\"name\": \"ok\",", "")).path, "/name");
-    const SceneError e = refuse(replace(k_valid, "\"type\": \"box\", \"min\": [0, 0, 0], \"max\": [0.2", "\"type\": \"cube\", \"min\": [0, 0, 0], \"max\": [0.2"));
+    const SceneError e =
+        refuse(replace(k_valid, "\"type\": \"box\", \"min\": [0, 0, 0], \"max\": [0.2",
+                       "\"type\": \"cube\", \"min\": [0, 0, 0], \"max\": [0.2"));
     EXPECT_EQ(e.path, "/fluid_blocks/0/shape/type");
     EXPECT_NE(e.expected.find("\"sphere\""), std::string::npos);
 }
@@ -82,40 +92,49 @@ TEST(SceneErrors, InvalidJsonSyntax) {
 
 TEST(SceneErrors, EmptyGeometry) {
     // A sphere smaller than the lattice spacing holds no sample point.
-    const SceneError e = refuse(replace(k_valid, R"({ "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] })",
-                                        R"({ "type": "sphere", "center": [0.1, 0.1, 0.1], "radius": 0.001 })"));
+    const SceneError e =
+        refuse(replace(k_valid, R"({ "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] })",
+                       R"({ "type": "sphere", "center": [0.1, 0.1, 0.1], "radius": 0.001 })"));
     EXPECT_EQ(e.path, "/fluid_blocks/0/shape");
     EXPECT_NE(e.found.find("empty"), std::string::npos);
     // A difference that removes everything.
-    const SceneError d = refuse(replace(k_valid, R"({ "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] })",
+    const SceneError d = refuse(replace(
+        k_valid, R"({ "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] })",
         R"({ "type": "difference", "shapes": [ { "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] },
                                                { "type": "sphere", "center": [0.1, 0.1, 0.1], "radius": 1 } ] })"));
     EXPECT_EQ(d.path, "/fluid_blocks/0/shape");
     // A box whose max is not above its min.
-    EXPECT_EQ(refuse(replace(k_valid, "\"max\": [0.2, 0.2, 0.2]", "\"max\": [0.2, 0.0, 0.2]")).path, "/fluid_blocks/0/shape/max");
+    EXPECT_EQ(refuse(replace(k_valid, "\"max\": [0.2, 0.2, 0.2]", "\"max\": [0.2, 0.0, 0.2]")).path,
+              "/fluid_blocks/0/shape/max");
 }
 
 TEST(SceneErrors, OverlappingGeometry) {
-    const SceneError e = refuse(replace(k_valid, "\"fluid_blocks\": [",
+    const SceneError e = refuse(replace(
+        k_valid, "\"fluid_blocks\": [",
         R"("fluid_blocks": [ { "shape": { "type": "sphere", "center": [0.1, 0.1, 0.1], "radius": 0.08 } },)"));
     EXPECT_EQ(e.path, "/fluid_blocks/1/shape");
     EXPECT_NE(e.found.find("/fluid_blocks/0"), std::string::npos);
     // Fluid inside an obstacle.
-    const SceneError o = refuse(replace(k_valid, "\"walls\": [",
+    const SceneError o = refuse(replace(
+        k_valid, "\"walls\": [",
         R"("walls": [ { "shape": { "type": "cylinder", "base": [0.1, 0.1, 0], "top": [0.1, 0.1, 0.3], "radius": 0.05 } },)"));
     EXPECT_EQ(o.path, "/walls/0/shape");
     // Fluid sticking out of its container.
-    EXPECT_EQ(refuse(replace(k_valid, "\"max\": [0.5, 0.5, 0.5]", "\"max\": [0.5, 0.5, 0.1]")).path, "/walls/0/shape");
+    EXPECT_EQ(refuse(replace(k_valid, "\"max\": [0.5, 0.5, 0.5]", "\"max\": [0.5, 0.5, 0.1]")).path,
+              "/walls/0/shape");
 }
 
 TEST(SceneErrors, TooManyParticles) {
-    const SceneError e = refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": 0.0004"));
+    const SceneError e =
+        refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": 0.0004"));
     EXPECT_EQ(e.path, "/particle_spacing");
     EXPECT_NE(e.found.find("million"), std::string::npos);
 }
 
 TEST(SceneErrors, DomainMustHoldParticles) {
-    const SceneError e = refuse(replace(k_valid, "\"particle_spacing\": 0.05", "\"particle_spacing\": 0.05, \"domain\": {\"min\": [0,0,0], \"max\": [0.1,0.1,0.1]}"));
+    const SceneError e = refuse(replace(
+        k_valid, "\"particle_spacing\": 0.05",
+        "\"particle_spacing\": 0.05, \"domain\": {\"min\": [0,0,0], \"max\": [0.1,0.1,0.1]}"));
     EXPECT_EQ(e.path, "/domain");
 }
 
@@ -123,11 +142,13 @@ TEST(SceneFormat, GeneratedDocsAreCommitted) {
     std::ifstream in(std::string(KARST_SOURCE_DIR) + "/docs/scene_format.md");
     std::stringstream ss;
     ss << in.rdbuf();
-    EXPECT_EQ(ss.str(), scene_schema_markdown()) << "regenerate with: karst schema > docs/scene_format.md";
+    EXPECT_EQ(ss.str(), scene_schema_markdown())
+        << "regenerate with: karst schema > docs/scene_format.md";
 }
 
 TEST(SceneFormat, ShippedScenesAreValid) {
-    for (const char* name : {"dam_break_obstacle.json", "martin_moyce_dam_break.json", "bench_dam_break_118k.json"}) {
+    for (const char* name :
+         {"dam_break_obstacle.json", "martin_moyce_dam_break.json", "bench_dam_break_118k.json"}) {
         const std::string path = std::string(KARST_SOURCE_DIR) + "/scenes/" + name;
         EXPECT_NO_THROW(load_scene_file(path)) << path;
     }

@@ -13,7 +13,8 @@ auto lattice_integral(Real h, const F& f) {
     decltype(f(Vec3::Zero())) sum = f(Vec3::Zero()) * 0;
     for (int k = -n; k <= n; ++k)
         for (int j = -n; j <= n; ++j)
-            for (int i = -n; i <= n; ++i) sum += f(Vec3(i + 0.5, j + 0.5, k + 0.5) * d) * (d * d * d);
+            for (int i = -n; i <= n; ++i)
+                sum += f(Vec3(i + 0.5, j + 0.5, k + 0.5) * d) * (d * d * d);
     return sum;
 }
 
@@ -46,7 +47,8 @@ TEST(SpikyKernel, M1IntegratesToOneWithNegativeGradient) {
     for (int d = 0; d < 3; ++d) {
         Vec3 dx = Vec3::Zero();
         dx[d] = e;
-        EXPECT_NEAR(W.gradient(x)[d], (W.w((x + dx).norm()) - W.w((x - dx).norm())) / (2 * e), 1e-5 * W.gradient(x).norm());
+        EXPECT_NEAR(W.gradient(x)[d], (W.w((x + dx).norm()) - W.w((x - dx).norm())) / (2 * e),
+                    1e-5 * W.gradient(x).norm());
     }
 }
 

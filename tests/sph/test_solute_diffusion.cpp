@@ -42,7 +42,8 @@ TEST(SoluteDiffusion, TwoHalfSpacesFollowTheErfProfile) {
     }
     Real worst = 0;
     for (const auto& [column, acc] : columns) {
-        const Real x = (column + 0.5) * 0.01, exact = 0.5 * std::erfc((x - 0.2) / (2 * std::sqrt(D * t)));
+        const Real x = (column + 0.5) * 0.01,
+                   exact = 0.5 * std::erfc((x - 0.2) / (2 * std::sqrt(D * t)));
         worst = std::max(worst, std::abs(acc.first / acc.second - exact));
     }
     EXPECT_LT(worst, 0.01) << "largest deviation from the erf profile (of a unit jump)";

@@ -22,7 +22,9 @@ struct Simulation {
 
     /// One step of the length a run takes (the CFL or fixed step, landing on Biot calls).
     StepReport advance() {
-        const StepReport r = step(model, state, next_step_length(model, state, std::numeric_limits<Real>::infinity()), profile);
+        const StepReport r =
+            step(model, state,
+                 next_step_length(model, state, std::numeric_limits<Real>::infinity()), profile);
         max_density_error = std::max(max_density_error, r.max_density_error);
         return r;
     }

@@ -20,8 +20,8 @@ struct InternalError : std::runtime_error {
 }  // namespace karst
 
 /// Always on and cheap.
-#define KARST_CHECK(cond, ...)                                                        \
-    do {                                                                              \
+#define KARST_CHECK(cond, ...)                                                                    \
+    do {                                                                                          \
         if (!(cond)) ::karst::fail_check(#cond, __FILE__, __LINE__, fmt::format("" __VA_ARGS__)); \
     } while (false)
 

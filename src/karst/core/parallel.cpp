@@ -16,7 +16,9 @@ ThreadLimit::ThreadLimit(int threads) : m_impl(new Impl) {
             tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
 }
 
-ThreadLimit::~ThreadLimit() { delete m_impl; }
+ThreadLimit::~ThreadLimit() {
+    delete m_impl;
+}
 
 int ThreadLimit::active_threads() {
     return static_cast<int>(

@@ -33,7 +33,8 @@ T deterministic_reduce(Index n, T identity, const F& f, const Combine& combine) 
     std::vector<T> partial(static_cast<size_t>(blocks), identity);
     parallel_for(blocks, [&](Index b) {
         T acc = identity;
-        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) acc = combine(acc, f(i));
+        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+            acc = combine(acc, f(i));
         partial[b] = acc;
     });
     T acc = identity;

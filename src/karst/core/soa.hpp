@@ -40,7 +40,9 @@ void apply_permutation(std::vector<T>& a, const std::vector<std::uint32_t>& perm
 /// Every attribute resized to n; new elements are zero.
 template <class Set>
 void resize_attributes(Set& set, std::size_t n) {
-    Set::for_each_attribute([&](auto& a) { a.resize(n, zero_value<typename std::decay_t<decltype(a)>::value_type>()); }, set);
+    Set::for_each_attribute(
+        [&](auto& a) { a.resize(n, zero_value<typename std::decay_t<decltype(a)>::value_type>()); },
+        set);
 }
 
 /// Keeps the particles whose flag is set, in order.
@@ -58,7 +60,8 @@ void permute_attributes(Set& set, const std::vector<std::uint32_t>& perm) {
 /// Appends the particles of `other`.
 template <class Set>
 void append_attributes(Set& set, const Set& other) {
-    Set::for_each_attribute([](auto& a, const auto& b) { a.insert(a.end(), b.begin(), b.end()); }, set, other);
+    Set::for_each_attribute([](auto& a, const auto& b) { a.insert(a.end(), b.begin(), b.end()); },
+                            set, other);
 }
 
 /// True when every attribute has `n` elements.

@@ -23,11 +23,16 @@ void compute_fluid_reactions(const Model& model, State& state) {
             Vec3 a_on_i = Vec3::Zero();
             if (f.p[i] != 0 || f.p_divergence[i] != 0) {
                 const Real c = boundary_pressure_coefficient(s.psi[k], inv_rho0_2, W, x_ik);
-                if (f.p[i] != 0) a_on_i -= boundary_pressure_term(f.p[i], c, -rho0_g.dot(x_ik), x_ik);
-                // DFSPH's divergence pressure acts on the boundary mirrored (sph/pressure_acceleration.hpp).
-                if (f.p_divergence[i] != 0) a_on_i -= boundary_pressure_term(f.p_divergence[i], c, 0, x_ik);
+                if (f.p[i] != 0)
+                    a_on_i -= boundary_pressure_term(f.p[i], c, -rho0_g.dot(x_ik), x_ik);
+                // DFSPH's divergence pressure acts on the boundary mirrored
+                // (sph/pressure_acceleration.hpp).
+                if (f.p_divergence[i] != 0)
+                    a_on_i -= boundary_pressure_term(f.p_divergence[i], c, 0, x_ik);
             }
-            if (shear.any()) a_on_i += boundary_shear_acceleration(shear, W, x_ik, f.v[i] - porous.v[k], f.rho[i], s.psi[k]);
+            if (shear.any())
+                a_on_i += boundary_shear_acceleration(shear, W, x_ik, f.v[i] - porous.v[k],
+                                                      f.rho[i], s.psi[k]);
             force -= f.sph_mass[i] * a_on_i;  // = m_i times the fluid side's acceleration
         });
         s.force[k] = force;

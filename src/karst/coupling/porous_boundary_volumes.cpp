@@ -11,7 +11,8 @@ void update_porous_boundary_volumes(const Model& model, State& state) {
     s.psi.resize(x.size());
     parallel_for(Index(x.size()), [&](Index k) {
         Real sum = W.w0();
-        s.porous_porous.for_each(k, [&](Index l) { sum += W.w((x[k] - x[l]).norm()); });  // 0 beyond h
+        s.porous_porous.for_each(k,
+                                 [&](Index l) { sum += W.w((x[k] - x[l]).norm()); });  // 0 beyond h
         s.porous_wall.for_each(k, [&](Index l) { sum += W.w((x[k] - model.walls.x[l]).norm()); });
         s.psi[k] = model.rho0 * std::min(model.lattice_volume, 1 / sum);
     });

@@ -24,7 +24,9 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     }
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);
-    if (ec) throw std::runtime_error(fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), path.string(), ec.message()));
+    if (ec)
+        throw std::runtime_error(fmt::format("cannot rename '{}' to '{}': {}", tmp.string(),
+                                             path.string(), ec.message()));
 }
 
 }  // namespace karst

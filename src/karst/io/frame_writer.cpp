@@ -16,7 +16,8 @@ FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings)
     : m_dir(std::move(dir)), m_settings(settings) {
     fs::create_directories(m_dir);
     // Frames of an earlier, longer run would otherwise sit beside this run's.
-    static const std::regex ours(R"((fluid_\d+\.(vtp|ply)|mesh_\d+\.vtu|porous_\d+\.vtp|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
+    static const std::regex ours(
+        R"((fluid_\d+\.(vtp|ply)|mesh_\d+\.vtu|porous_\d+\.vtp|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
     for (const auto& entry : fs::directory_iterator(m_dir))
         if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours))
             fs::remove(entry.path());
@@ -48,33 +49,46 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         for (Index i = 0; i < fluid.size(); ++i) concentration[i] = fluid.solute[i] / fluid.mass[i];
         points.add_scalar("concentration", concentration);
         points.add_integer("id", fluid.id);
-        if (m_settings.vtp) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame), vtp_bytes(points));
-        if (m_settings.ply) write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
+        if (m_settings.vtp)
+            write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame),
+                                  vtp_bytes(points));
+        if (m_settings.ply)
+            write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame),
+                                  ply_bytes(points));
     }
     if (parts.mesh && m_settings.vtp)
-        write_file_atomically(m_dir / fmt::format("mesh_{:04d}.vtu", frame), vtu_bytes(parts.mesh->nodes, parts.mesh->tets));
+        write_file_atomically(m_dir / fmt::format("mesh_{:04d}.vtu", frame),
+                              vtu_bytes(parts.mesh->nodes, parts.mesh->tets));
     m_log.push_back(log);
     if (parts.porous && m_settings.vtp)
-        write_file_atomically(m_dir / fmt::format("porous_{:04d}.vtp", frame), vtp_bytes(*parts.porous));
+        write_file_atomically(m_dir / fmt::format("porous_{:04d}.vtp", frame),
+                              vtp_bytes(*parts.porous));
     m_written.push_back({parts.fluid != nullptr, parts.mesh != nullptr, parts.porous != nullptr});
 
     if (m_settings.vtp) {
         // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles.
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {
-            if (m_written[f].fluid) entries.push_back({m_log[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
+            if (m_written[f].fluid)
+                entries.push_back({m_log[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
             if (m_has_boundary) entries.push_back({m_log[f].time, 1, "boundary.vtp"});
-            if (m_written[f].mesh) entries.push_back({m_log[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
-            if (m_written[f].porous) entries.push_back({m_log[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
+            if (m_written[f].mesh)
+                entries.push_back({m_log[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
+            if (m_written[f].porous)
+                entries.push_back({m_log[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
         }
         write_file_atomically(m_dir / "run.pvd", pvd_bytes(entries));
     }
-    std::string csv = "frame,time,dt,steps,particles,removed,density_error,mipps,speed_p99,max_speed,kinetic_energy,potential_energy,total_energy\n";
+    std::string csv =
+        "frame,time,dt,steps,particles,removed,density_error,mipps,speed_p99,max_speed,kinetic_"
+        "energy,potential_energy,total_energy\n";
     for (int f = 0; f < frames(); ++f) {
         const FrameLog& r = m_log[f];
-        csv += fmt::format("{},{:.9g},{:.6g},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g}\n", f, r.time, r.dt, r.steps,
-                           r.particles, r.removed, r.density_error, r.mipps, r.speed_p99, r.max_speed, r.kinetic_energy, r.potential_energy,
-                           r.kinetic_energy + r.potential_energy);
+        csv += fmt::format(
+            "{},{:.9g},{:.6g},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g}\n", f,
+            r.time, r.dt, r.steps, r.particles, r.removed, r.density_error, r.mipps, r.speed_p99,
+            r.max_speed, r.kinetic_energy, r.potential_energy,
+            r.kinetic_energy + r.potential_energy);
     }
     write_file_atomically(m_dir / "log.csv", csv);
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The output folder of a run: per-frame fluid and mesh files, the static boundary, run.pvd,
-// log.csv and stats.json. Each file is written atomically; run.pvd and log.csv are rewritten after every
-// frame, so the folder is complete and consistent whenever a run stops.
+// log.csv and stats.json. Each file is written atomically; run.pvd and log.csv are rewritten after
+// every frame, so the folder is complete and consistent whenever a run stops.
 #include "karst/io/point_arrays.hpp"
 #include "karst/scene/scene.hpp"
 #include "karst/sim/model.hpp"
@@ -17,17 +17,17 @@ namespace karst {
 
 /// One row of log.csv.
 struct FrameLog {
-    Real time = 0;               ///< s
-    Real dt = 0;                 ///< last step, s
-    Index steps = 0;             ///< steps so far
-    Index particles = 0;         ///< fluid particles now
-    Real density_error = 0;      ///< largest PCISPH density error since the last frame (fraction)
-    Real mipps = 0;              ///< million particle-steps per second since the last frame
-    Real kinetic_energy = 0;     ///< fluid + porous particles, J (sim/energy.hpp)
-    Real potential_energy = 0;   ///< -sum m g.x, J
-    Index removed = 0;           ///< fluid particles that left the domain so far
-    Real speed_p99 = 0;          ///< 99th percentile of the fluid particles' speed, m/s
-    Real max_speed = 0;          ///< fastest fluid particle, m/s
+    Real time = 0;              ///< s
+    Real dt = 0;                ///< last step, s
+    Index steps = 0;            ///< steps so far
+    Index particles = 0;        ///< fluid particles now
+    Real density_error = 0;     ///< largest PCISPH density error since the last frame (fraction)
+    Real mipps = 0;             ///< million particle-steps per second since the last frame
+    Real kinetic_energy = 0;    ///< fluid + porous particles, J (sim/energy.hpp)
+    Real potential_energy = 0;  ///< -sum m g.x, J
+    Index removed = 0;          ///< fluid particles that left the domain so far
+    Real speed_p99 = 0;         ///< 99th percentile of the fluid particles' speed, m/s
+    Real max_speed = 0;         ///< fastest fluid particle, m/s
 };
 
 /// The PFEM meshes of a frame, as one tetrahedral grid with its point arrays.
@@ -60,7 +60,9 @@ private:
     OutputSettings m_settings;
     bool m_has_boundary = false;
     std::vector<FrameLog> m_log;
-    struct Written { bool fluid, mesh, porous; };
+    struct Written {
+        bool fluid, mesh, porous;
+    };
     std::vector<Written> m_written;  ///< which parts each frame has
 };
 

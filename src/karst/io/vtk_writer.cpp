@@ -22,7 +22,8 @@ void PointSet::add_integer(std::string name, const std::vector<std::int64_t>& v)
 void PointSet::add_symmetric_tensor(std::string name, const std::vector<Mat3>& v) {
     PointArray a{std::move(name), 6, false, {}};
     a.values.reserve(6 * v.size());
-    for (const Mat3& m : v) a.values.insert(a.values.end(), {m(0, 0), m(1, 1), m(2, 2), m(0, 1), m(1, 2), m(0, 2)});
+    for (const Mat3& m : v)
+        a.values.insert(a.values.end(), {m(0, 0), m(1, 1), m(2, 2), m(0, 1), m(1, 2), m(0, 2)});
     arrays.push_back(std::move(a));
 }
 
@@ -36,7 +37,9 @@ void append_block(std::string& blob, const std::vector<T>& values) {
     blob.append(reinterpret_cast<const char*>(values.data()), bytes);
 }
 
-std::vector<float> to_float(const std::vector<double>& v) { return {v.begin(), v.end()}; }
+std::vector<float> to_float(const std::vector<double>& v) {
+    return {v.begin(), v.end()};
+}
 
 /// Appends the point arrays and the positions to `blob`; returns the <PointData> entries and
 /// the offset of the positions block.
@@ -44,7 +47,8 @@ std::pair<std::string, size_t> append_points(std::string& blob, const PointSet& 
     std::string point_data;
     for (const PointArray& a : points.arrays) {
         point_data += fmt::format(
-            "        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
+            "        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" "
+            "format=\"appended\" offset=\"{}\"/>\n",
             a.integer ? "Int64" : "Float32", a.name, a.components, blob.size());
         if (a.integer)
             append_block(blob, std::vector<std::int64_t>(a.values.begin(), a.values.end()));
@@ -77,23 +81,28 @@ std::string vtp_bytes(const PointSet& points) {
     append_block(blob, conn);
     const size_t offsets_offset = blob.size();
     append_block(blob, offsets);
-    return finish(fmt::format(
-        "<?xml version=\"1.0\"?>\n"
-        "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-        "  <PolyData>\n"
-        "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
-        "      <PointData>\n{1}      </PointData>\n"
-        "      <Points>\n"
-        "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{2}\"/>\n"
-        "      </Points>\n"
-        "      <Verts>\n"
-        "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{3}\"/>\n"
-        "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{4}\"/>\n"
-        "      </Verts>\n"
-        "    </Piece>\n"
-        "  </PolyData>\n"
-        "  <AppendedData encoding=\"raw\">\n   _",
-        n, point_data, points_offset, conn_offset, offsets_offset), blob);
+    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
+                              "<VTKFile type=\"PolyData\" version=\"1.0\" "
+                              "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                              "  <PolyData>\n"
+                              "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\" "
+                              "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+                              "      <PointData>\n{1}      </PointData>\n"
+                              "      <Points>\n"
+                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                              "format=\"appended\" offset=\"{2}\"/>\n"
+                              "      </Points>\n"
+                              "      <Verts>\n"
+                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+                              "format=\"appended\" offset=\"{3}\"/>\n"
+                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
+                              "format=\"appended\" offset=\"{4}\"/>\n"
+                              "      </Verts>\n"
+                              "    </Piece>\n"
+                              "  </PolyData>\n"
+                              "  <AppendedData encoding=\"raw\">\n   _",
+                              n, point_data, points_offset, conn_offset, offsets_offset),
+                  blob);
 }
 
 std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets) {
@@ -111,32 +120,40 @@ std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index
     append_block(blob, offsets);
     const size_t types_offset = blob.size();
     append_block(blob, std::vector<std::uint8_t>(tets.size(), 10));  // VTK_TETRA
-    return finish(fmt::format(
-        "<?xml version=\"1.0\"?>\n"
-        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-        "  <UnstructuredGrid>\n"
-        "    <Piece NumberOfPoints=\"{0}\" NumberOfCells=\"{1}\">\n"
-        "      <PointData>\n{2}      </PointData>\n"
-        "      <Points>\n"
-        "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{3}\"/>\n"
-        "      </Points>\n"
-        "      <Cells>\n"
-        "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{4}\"/>\n"
-        "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{5}\"/>\n"
-        "        <DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{6}\"/>\n"
-        "      </Cells>\n"
-        "    </Piece>\n"
-        "  </UnstructuredGrid>\n"
-        "  <AppendedData encoding=\"raw\">\n   _",
-        points.x.size(), tets.size(), point_data, points_offset, conn_offset, offsets_offset, types_offset), blob);
+    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
+                              "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+                              "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                              "  <UnstructuredGrid>\n"
+                              "    <Piece NumberOfPoints=\"{0}\" NumberOfCells=\"{1}\">\n"
+                              "      <PointData>\n{2}      </PointData>\n"
+                              "      <Points>\n"
+                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                              "format=\"appended\" offset=\"{3}\"/>\n"
+                              "      </Points>\n"
+                              "      <Cells>\n"
+                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+                              "format=\"appended\" offset=\"{4}\"/>\n"
+                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
+                              "format=\"appended\" offset=\"{5}\"/>\n"
+                              "        <DataArray type=\"UInt8\" Name=\"types\" "
+                              "format=\"appended\" offset=\"{6}\"/>\n"
+                              "      </Cells>\n"
+                              "    </Piece>\n"
+                              "  </UnstructuredGrid>\n"
+                              "  <AppendedData encoding=\"raw\">\n   _",
+                              points.x.size(), tets.size(), point_data, points_offset, conn_offset,
+                              offsets_offset, types_offset),
+                  blob);
 }
 
 std::string pvd_bytes(const std::vector<PvdEntry>& entries) {
     std::string out =
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
+        "byte_order=\"LittleEndian\">\n"
         "  <Collection>\n";
     for (const PvdEntry& e : entries)
-        out += fmt::format("    <DataSet timestep=\"{:.17g}\" part=\"{}\" file=\"{}\"/>\n", e.time, e.part, e.file);
+        out += fmt::format("    <DataSet timestep=\"{:.17g}\" part=\"{}\" file=\"{}\"/>\n", e.time,
+                           e.part, e.file);
     out += "  </Collection>\n</VTKFile>\n";
     return out;
 }

@@ -65,7 +65,8 @@ struct AmgSolver::Impl {
     std::vector<HYPRE_Int> rows;  // 0 .. n-1, for setting and getting whole vectors
     Real t_setup = 0;
 
-    Impl(const Eigen::SparseMatrix<Real, Eigen::ColMajor, int>& A, AmgOptions o) : n(int(A.rows())), options(std::move(o)) {
+    Impl(const Eigen::SparseMatrix<Real, Eigen::ColMajor, int>& A, AmgOptions o)
+        : n(int(A.rows())), options(std::move(o)) {
         HypreRuntime::ensure();
         Stopwatch watch;
         const MPI_Comm comm = MPI_COMM_WORLD;
@@ -74,10 +75,13 @@ struct AmgSolver::Impl {
         check(HYPRE_IJMatrixSetObjectType(ij_matrix, HYPRE_PARCSR), "matrix type");
         std::vector<HYPRE_Int> sizes(n);
         rows.resize(n);
-        for (int r = 0; r < n; ++r) sizes[r] = A.outerIndexPtr()[r + 1] - A.outerIndexPtr()[r], rows[r] = r;
+        for (int r = 0; r < n; ++r)
+            sizes[r] = A.outerIndexPtr()[r + 1] - A.outerIndexPtr()[r], rows[r] = r;
         check(HYPRE_IJMatrixSetRowSizes(ij_matrix, sizes.data()), "row sizes");
         check(HYPRE_IJMatrixInitialize(ij_matrix), "matrix initialise");
-        check(HYPRE_IJMatrixSetValues(ij_matrix, n, sizes.data(), rows.data(), A.innerIndexPtr(), A.valuePtr()), "matrix values");
+        check(HYPRE_IJMatrixSetValues(ij_matrix, n, sizes.data(), rows.data(), A.innerIndexPtr(),
+                                      A.valuePtr()),
+              "matrix values");
         check(HYPRE_IJMatrixAssemble(ij_matrix), "matrix assemble");
         HYPRE_IJMatrixGetObject(ij_matrix, reinterpret_cast<void**>(&matrix));
         for (HYPRE_IJVector* v : {&ij_b, &ij_x, &ij_r}) {
@@ -152,7 +156,8 @@ struct AmgSolver::Impl {
         HYPRE_PCGGetFinalRelativeResidualNorm(pcg, &residual);
         HYPRE_ClearAllErrors();  // "not converged" is judged below, on the residual
         if (!(residual * std::sqrt(right_side) <= target * (1 + 1e-9)))
-            throw std::runtime_error("AMG-preconditioned CG did not converge: relative residual " + std::to_string(residual) + " after " +
+            throw std::runtime_error("AMG-preconditioned CG did not converge: relative residual " +
+                                     std::to_string(residual) + " after " +
                                      std::to_string(iterations) + " iterations");
         HYPRE_IJVectorGetValues(ij_x, n, rows.data(), solution.data());
         return iterations;
@@ -165,7 +170,11 @@ AmgSolver::~AmgSolver() = default;
 AmgSolver::AmgSolver(AmgSolver&&) noexcept = default;
 AmgSolver& AmgSolver::operator=(AmgSolver&&) noexcept = default;
 
-int AmgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) { return m_impl->solve(b, x); }
-Real AmgSolver::seconds_setup() const { return m_impl->t_setup; }
+int AmgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    return m_impl->solve(b, x);
+}
+Real AmgSolver::seconds_setup() const {
+    return m_impl->t_setup;
+}
 
 }  // namespace karst

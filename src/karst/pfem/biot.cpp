@@ -16,7 +16,8 @@
 
 namespace karst {
 
-BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o) : mesh(m), problem(std::move(p)), options(o), n(m.node_count()) {
+BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
+    : mesh(m), problem(std::move(p)), options(o), n(m.node_count()) {
     KARST_CHECK(problem.mobility.size() == size_t(mesh.tet_count()));
     Stopwatch watch;
     elements.resize(mesh.tet_count());
@@ -25,7 +26,8 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o) : mesh(m)
     if (options.polyhedral) {
         Real spacing = 0;  // gradient step 1e-4 of the mean edge length (M21: 1e-4 dx)
         for (const Tet& t : mesh.tets) spacing += (mesh.nodes[t[1]] - mesh.nodes[t[0]]).norm();
-        polyhedra = polyhedral_elements(mesh, 1e-4 * spacing / std::max<Index>(1, mesh.tet_count()));
+        polyhedra =
+            polyhedral_elements(mesh, 1e-4 * spacing / std::max<Index>(1, mesh.tet_count()));
         assemble_polyhedral_mechanics();
         std::tie(K_ff, K_fc) = u_dofs.split(K);
         elastic_lift = K_fc * u_dofs.gather_prescribed(u_prescribed);
@@ -42,8 +44,11 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o) : mesh(m)
     // A free body's six near-rigid modes (eps diag K) defeat CG: it stays direct.
     elastic_iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
     flow_iterative = options.linear_solver == LinearSolver::Amg ||
-                     (options.linear_solver == LinearSolver::Auto && p_dofs.free_count >= options.amg_flow_unknowns);
-    if (u_dofs.free_count > 0) elastic.compute(K_ff, elastic_iterative, elastic_iterative ? elastic_amg_options() : AmgOptions{});
+                     (options.linear_solver == LinearSolver::Auto &&
+                      p_dofs.free_count >= options.amg_flow_unknowns);
+    if (u_dofs.free_count > 0)
+        elastic.compute(K_ff, elastic_iterative,
+                        elastic_iterative ? elastic_amg_options() : AmgOptions{});
     t_elastic_factor = factor_watch.seconds();
 }
 
@@ -102,26 +107,34 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
     // call's last mechanics solve, from the u that solve returned (a poroelastic-only run
     // under steady loads), has that u as its predictor and skips the solve.
     const Vector rhs_predictor = u_dofs.gather_free(f_ext + Q * p) - elastic_lift;
-    const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() && rhs_predictor == last_elastic_rhs && u == last_elastic_u;
-    if (!as_last_solve && u_dofs.free_count > 0) u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u), ++report.elastic_solves;
+    const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() &&
+                               rhs_predictor == last_elastic_rhs && u == last_elastic_u;
+    if (!as_last_solve && u_dofs.free_count > 0)
+        u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u),
+            ++report.elastic_solves;
     // Anderson mixing of the pressure iterates [D] (beyond M22): fewer fixed-stress iterations
     // per call, most where tau is large. The fixed-strain order is left plain: it is kept to
     // show the paper's divergence.
-    const bool accelerate = options.anderson_depth > 0 && options.splitting == Splitting::FixedStress;
+    const bool accelerate =
+        options.anderson_depth > 0 && options.splitting == Splitting::FixedStress;
     AndersonMixing anderson(options.anderson_depth);
     for (int k = 0; k < options.max_iterations; ++k) {
-        // 1. Flow with u frozen: (S + L M + dt H) p = (S + L M) p^n + dt b - Q^T (u^k - u^n) + L M (p^k - p^n).
+        // 1. Flow with u frozen: (S + L M + dt H) p = (S + L M) p^n + dt b - Q^T (u^k - u^n) + L M
+        // (p^k - p^n).
         const Vector rhs_full = flow_constant - Q.transpose() * (u - u_n) + L * (mass * (p - p_n));
         Vector p_next = p;
         if (p_dofs.free_count > 0)
-            p_dofs.scatter_free(flow.solve(p_dofs.gather_free(rhs_full) - dt * (H_fc * p_c), p_dofs.gather_free(p)), p_next);
+            p_dofs.scatter_free(
+                flow.solve(p_dofs.gather_free(rhs_full) - dt * (H_fc * p_c), p_dofs.gather_free(p)),
+                p_next);
         // The fixed-point residual G(p^k) - p^k, before any mixing, is what the test below reads.
         report.p_change.push_back(relative_change(p_next - p_n, p - p_n));
         if (accelerate) p_next = anderson.next(p, p_next);
         // 2. Mechanics with p frozen: K u = f_ext + Q p.
         const Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
         Vector u_next = u;
-        if (u_dofs.free_count > 0) u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
+        if (u_dofs.free_count > 0)
+            u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
         last_elastic_rhs = rhs_u, last_elastic_u = u_next;
         ++report.elastic_solves;
         // 3. Changes relative to the change over the call [D]: M22 divides by |p^{k+1}|, but
@@ -130,7 +143,8 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
         report.u_change.push_back(relative_change(u_next - u_n, u - u_n));
         p = std::move(p_next), u = std::move(u_next);
         ++report.iterations;
-        if (report.p_change.back() < options.tolerance && report.u_change.back() < options.tolerance) {
+        if (report.p_change.back() < options.tolerance &&
+            report.u_change.back() < options.tolerance) {
             report.converged = true;
             break;
         }
@@ -148,7 +162,9 @@ BiotSolver::~BiotSolver() = default;
 BiotSolver::BiotSolver(BiotSolver&&) noexcept = default;
 BiotSolver& BiotSolver::operator=(BiotSolver&&) noexcept = default;
 
-BiotCallReport BiotSolver::advance(Real dt, BiotFields& fields) { return m_impl->advance(dt, fields); }
+BiotCallReport BiotSolver::advance(Real dt, BiotFields& fields) {
+    return m_impl->advance(dt, fields);
+}
 
 void BiotSolver::set_mobility(std::vector<Mat3> mobility) {
     KARST_CHECK(mobility.size() == size_t(m_impl->mesh.tet_count()));
@@ -161,11 +177,23 @@ void BiotSolver::set_extra_loads(const std::vector<Vec3>& loads) {
     m_impl->f_ext = m_impl->f_problem + Eigen::Map<const Vector>(loads[0].data(), 3 * m_impl->n);
 }
 
-const BiotProblem& BiotSolver::problem() const { return m_impl->problem; }
-Real BiotSolver::seconds_assembly() const { return m_impl->t_assembly; }
-Real BiotSolver::seconds_elastic_factorisation() const { return m_impl->t_elastic_factor; }
-Index BiotSolver::displacement_unknowns() const { return m_impl->u_dofs.free_count; }
-bool BiotSolver::elastic_by_amg() const { return m_impl->elastic_iterative; }
-bool BiotSolver::flow_by_amg() const { return m_impl->flow_iterative; }
+const BiotProblem& BiotSolver::problem() const {
+    return m_impl->problem;
+}
+Real BiotSolver::seconds_assembly() const {
+    return m_impl->t_assembly;
+}
+Real BiotSolver::seconds_elastic_factorisation() const {
+    return m_impl->t_elastic_factor;
+}
+Index BiotSolver::displacement_unknowns() const {
+    return m_impl->u_dofs.free_count;
+}
+bool BiotSolver::elastic_by_amg() const {
+    return m_impl->elastic_iterative;
+}
+bool BiotSolver::flow_by_amg() const {
+    return m_impl->flow_iterative;
+}
 
 }  // namespace karst

@@ -11,22 +11,27 @@
 namespace karst {
 
 struct BiotMaterial {
-    Real youngs_modulus = 1e9;   ///< drained skeleton, Pa
+    Real youngs_modulus = 1e9;  ///< drained skeleton, Pa
     Real poisson_ratio = 0.25;
-    Real biot_coefficient = 1;   ///< B = 1 - K_dr / K_s
-    Real storage = 0;            ///< 1/M = phi/K_f + (B - phi)/K_s, 1/Pa
-    Real fluid_density = 1000;   ///< rho0 of the gravity flux, kg/m^3
-    Real bulk_density = 2000;    ///< rho_bulk of the body force, kg/m^3
+    Real biot_coefficient = 1;  ///< B = 1 - K_dr / K_s
+    Real storage = 0;           ///< 1/M = phi/K_f + (B - phi)/K_s, 1/Pa
+    Real fluid_density = 1000;  ///< rho0 of the gravity flux, kg/m^3
+    Real bulk_density = 2000;   ///< rho_bulk of the body force, kg/m^3
 
-    Real lame_lambda() const { return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)); }
+    Real lame_lambda() const {
+        return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio));
+    }
     Real shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
     Real drained_bulk_modulus() const { return lame_lambda() + 2 * shear_modulus() / 3; }
     /// K_s from B = 1 - K_dr / K_s (infinite for B = 1: incompressible grains).
     Real grain_bulk_modulus() const {
-        return biot_coefficient < 1 ? drained_bulk_modulus() / (1 - biot_coefficient) : std::numeric_limits<Real>::infinity();
+        return biot_coefficient < 1 ? drained_bulk_modulus() / (1 - biot_coefficient)
+                                    : std::numeric_limits<Real>::infinity();
     }
     /// Kim et al.'s coupling strength tau = B^2 M / K_dr: the fixed-strain split needs tau < 1.
-    Real coupling_strength() const { return biot_coefficient * biot_coefficient / (storage * drained_bulk_modulus()); }
+    Real coupling_strength() const {
+        return biot_coefficient * biot_coefficient / (storage * drained_bulk_modulus());
+    }
 };
 
 /// Displacement components fixed at a node, as bits.
@@ -61,8 +66,8 @@ enum class LinearSolver { Auto, Direct, Amg };
 
 struct BiotOptions {
     Splitting splitting = Splitting::FixedStress;
-    int max_iterations = 5;   ///< M22: k_max
-    Real tolerance = 1e-3;    ///< M22 stopping test on relative changes of p and u
+    int max_iterations = 5;  ///< M22: k_max
+    Real tolerance = 1e-3;   ///< M22 stopping test on relative changes of p and u
     /// Anderson acceleration of the fixed-stress pressure iterates over this many previous ones
     /// (0: the plain M22 iteration).
     int anderson_depth = 3;
@@ -126,10 +131,13 @@ private:
 /// Nodal forces of a uniform traction (Pa, world frame) on the boundary facets whose three nodes
 /// all satisfy `on_region`: each facet gives area/3 times the traction to each of its nodes.
 template <class Predicate>
-std::vector<Vec3> traction_loads(const TetMesh& mesh, const Vec3& traction, const Predicate& on_region) {
+std::vector<Vec3> traction_loads(const TetMesh& mesh, const Vec3& traction,
+                                 const Predicate& on_region) {
     std::vector<Vec3> force(mesh.node_count(), Vec3::Zero());
     for (const Triangle& t : mesh.boundary) {
-        if (!on_region(mesh.nodes[t[0]]) || !on_region(mesh.nodes[t[1]]) || !on_region(mesh.nodes[t[2]])) continue;
+        if (!on_region(mesh.nodes[t[0]]) || !on_region(mesh.nodes[t[1]]) ||
+            !on_region(mesh.nodes[t[2]]))
+            continue;
         const Real area = mesh.area_vector(t).norm();
         for (Index a : t) force[a] += traction * (area / 3);
     }

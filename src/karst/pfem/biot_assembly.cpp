@@ -87,9 +87,12 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
             const int ib = int(std::find(t.begin(), t.end(), b) - t.begin());
             const Vec3& gb = p.grad[ib];
             for (int ia = 0; ia < 4; ++ia) {
-                const size_t pos = size_t(std::lower_bound(nb.begin(), nb.end(), t[ia]) - nb.begin());
+                const size_t pos =
+                    size_t(std::lower_bound(nb.begin(), nb.end(), t[ia]) - nb.begin());
                 const Vec3& ga = p.grad[ia];
-                block[pos] += p.volume * (lambda * gb * ga.transpose() + mu * ga.dot(gb) * Mat3::Identity() + mu * ga * gb.transpose());
+                block[pos] +=
+                    p.volume * (lambda * gb * ga.transpose() + mu * ga.dot(gb) * Mat3::Identity() +
+                                mu * ga * gb.transpose());
                 coupling[pos] += (m.biot_coefficient * p.volume / 4) * ga;  // Q[3a+c, b]
                 consistent[pos] += p.volume * (ia == ib ? 2 : 1) / 20;
             }
@@ -106,7 +109,9 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
                     const Real value = block[pos](d, c);
                     if (const int row = free_u(nb[pos], c); row >= 0) {
                         K_ff.innerIndexPtr()[at] = row;
-                        K_ff.valuePtr()[at++] = nb[pos] == b && c == d && problem.free_body ? value * (1 + problem.rigid_mode_spring) : value;
+                        K_ff.valuePtr()[at++] = nb[pos] == b && c == d && problem.free_body
+                                                    ? value * (1 + problem.rigid_mode_spring)
+                                                    : value;
                     } else {
                         elastic_lift[col] += value * u_prescribed[3 * nb[pos] + c];
                     }
@@ -114,11 +119,14 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
         }
         int at = q_outer[b];
         for (size_t pos = 0; pos < nb.size(); ++pos)
-            for (int c = 0; c < 3; ++c) Q.innerIndexPtr()[at] = int(3 * nb[pos] + c), Q.valuePtr()[at++] = coupling[pos][c];
+            for (int c = 0; c < 3; ++c)
+                Q.innerIndexPtr()[at] = int(3 * nb[pos] + c), Q.valuePtr()[at++] = coupling[pos][c];
         at = m_outer[b];
-        for (size_t pos = 0; pos < nb.size(); ++pos) mass.innerIndexPtr()[at] = int(nb[pos]), mass.valuePtr()[at++] = consistent[pos];
+        for (size_t pos = 0; pos < nb.size(); ++pos)
+            mass.innerIndexPtr()[at] = int(nb[pos]), mass.valuePtr()[at++] = consistent[pos];
     });
-    for (Index a = 0; a < Index(problem.nodal_force.size()); ++a) f_ext.segment<3>(3 * a) += problem.nodal_force[a];
+    for (Index a = 0; a < Index(problem.nodal_force.size()); ++a)
+        f_ext.segment<3>(3 * a) += problem.nodal_force[a];
     storage = problem.material.storage * lumped_volume;
 }
 
@@ -130,7 +138,8 @@ void BiotSolver::Impl::assemble_polyhedral_mechanics() {
     f_ext = Vector::Zero(3 * n);
     for (const PolyhedralElement& element : polyhedra) {
         const int size = int(element.nodes.size());
-        Eigen::MatrixXd Ke = Eigen::MatrixXd::Zero(3 * size, 3 * size), Qe = Eigen::MatrixXd::Zero(3 * size, size);
+        Eigen::MatrixXd Ke = Eigen::MatrixXd::Zero(3 * size, 3 * size),
+                        Qe = Eigen::MatrixXd::Zero(3 * size, size);
         Eigen::Matrix<Real, 6, Eigen::Dynamic> B(6, 3 * size);
         for (const PolyhedralElement::Point& q : element.points) {
             B.setZero();
@@ -138,9 +147,11 @@ void BiotSolver::Impl::assemble_polyhedral_mechanics() {
                 const Vec3& g = q.grad[a];
                 set_strain_displacement_columns(B, a, g);
                 lumped_volume[element.nodes[a]] += q.weight * q.N[a];
-                f_ext.segment<3>(3 * element.nodes[a]) += m.bulk_density * problem.gravity * (q.weight * q.N[a]);
+                f_ext.segment<3>(3 * element.nodes[a]) +=
+                    m.bulk_density * problem.gravity * (q.weight * q.N[a]);
                 for (int b = 0; b < size; ++b)
-                    for (int d = 0; d < 3; ++d) Qe(3 * a + d, b) += q.weight * m.biot_coefficient * g[d] * q.N[b];
+                    for (int d = 0; d < 3; ++d)
+                        Qe(3 * a + d, b) += q.weight * m.biot_coefficient * g[d] * q.N[b];
             }
             Ke += q.weight * B.transpose() * D * B;
         }
@@ -148,7 +159,9 @@ void BiotSolver::Impl::assemble_polyhedral_mechanics() {
             for (int c = 0; c < 3; ++c) {
                 const int row = int(3 * element.nodes[a] + c);
                 for (int b = 0; b < size; ++b) {
-                    for (int d = 0; d < 3; ++d) k_entries.emplace_back(row, int(3 * element.nodes[b] + d), Ke(3 * a + c, 3 * b + d));
+                    for (int d = 0; d < 3; ++d)
+                        k_entries.emplace_back(row, int(3 * element.nodes[b] + d),
+                                               Ke(3 * a + c, 3 * b + d));
                     q_entries.emplace_back(row, int(element.nodes[b]), Qe(3 * a + c, b));
                 }
             }
@@ -161,7 +174,8 @@ void BiotSolver::Impl::assemble_polyhedral_mechanics() {
     for (Index a = 0; a < n; ++a) mass.insert(a, a) = lumped_volume[a];
     if (problem.free_body)
         for (int i = 0; i < 3 * n; ++i) K.coeffRef(i, i) *= 1 + problem.rigid_mode_spring;
-    for (Index a = 0; a < Index(problem.nodal_force.size()); ++a) f_ext.segment<3>(3 * a) += problem.nodal_force[a];
+    for (Index a = 0; a < Index(problem.nodal_force.size()); ++a)
+        f_ext.segment<3>(3 * a) += problem.nodal_force[a];
     storage = problem.material.storage * lumped_volume;
 }
 
@@ -172,7 +186,8 @@ void BiotSolver::Impl::assemble_polyhedral_flow(Triplets& h_entries, const Vec3&
             for (size_t a = 0; a < element.nodes.size(); ++a) {
                 const Vec3 flux_a = mobility * q.grad[a];
                 for (size_t b = 0; b < element.nodes.size(); ++b)
-                    h_entries.emplace_back(int(element.nodes[a]), int(element.nodes[b]), q.weight * flux_a.dot(q.grad[b]));
+                    h_entries.emplace_back(int(element.nodes[a]), int(element.nodes[b]),
+                                           q.weight * flux_a.dot(q.grad[b]));
                 gravity_flux[element.nodes[a]] += q.weight * flux_a.dot(rho_g);
             }
         }
@@ -190,7 +205,8 @@ void BiotSolver::Impl::assemble_flow() {
         const Mat3& mobility = problem.mobility[e];
         for (int a = 0; a < 4; ++a) {
             const Vec3 flux_a = mobility * p.grad[a];  // Lambda is symmetric
-            for (int b = 0; b < 4; ++b) h_entries.emplace_back(int(t[a]), int(t[b]), p.volume * flux_a.dot(p.grad[b]));
+            for (int b = 0; b < 4; ++b)
+                h_entries.emplace_back(int(t[a]), int(t[b]), p.volume * flux_a.dot(p.grad[b]));
             gravity_flux[t[a]] += p.volume * flux_a.dot(rho_g);
         }
     }
@@ -208,7 +224,8 @@ void BiotSolver::Impl::split_dofs() {
         for (int c = 0; c < 3; ++c)
             if (problem.fixed[a] & (1 << c)) {
                 u_fixed[3 * a + c] = 1;
-                if (!problem.prescribed_u.empty()) u_prescribed[3 * a + c] = problem.prescribed_u[a][c];
+                if (!problem.prescribed_u.empty())
+                    u_prescribed[3 * a + c] = problem.prescribed_u[a][c];
             }
     for (Index a = 0; a < Index(problem.drained.size()); ++a)
         if (problem.drained[a]) {

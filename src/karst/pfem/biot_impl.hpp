@@ -16,20 +16,20 @@ struct BiotSolver::Impl {
     std::vector<P1Tet> elements;
     std::vector<PolyhedralElement> polyhedra;  // M21 option only
 
-    SparseMatrix K, Q, H;           // full matrices (3n x 3n, 3n x n, n x n)
-    SparseMatrix mass;              // consistent P1 mass (n x n) of the fixed-stress term
+    SparseMatrix K, Q, H;  // full matrices (3n x 3n, 3n x n, n x n)
+    SparseMatrix mass;     // consistent P1 mass (n x n) of the fixed-stress term
     SparseMatrix mass_ff;
     Vector lumped_volume, storage;  // per node: M_a, S_a
     Vector gravity_flux;            // b
     Vector f_ext;                   // body force + nodal loads
-    Vector f_problem;               // body force + the problem's nodal_force (f_ext without extra loads)
+    Vector f_problem;  // body force + the problem's nodal_force (f_ext without extra loads)
     Vector u_prescribed, p_prescribed;
 
     DofSplit u_dofs{{}}, p_dofs{{}};
     SparseMatrix K_ff, K_fc, H_ff, H_fc;
-    Vector elastic_lift;  // K_fc u_c
+    Vector elastic_lift;                      // K_fc u_c
     Vector last_elastic_rhs, last_elastic_u;  // the last mechanics solve: its right side and full u
-    SpdSolve elastic, flow;  // LinearSolver in biot.hpp says which each gets
+    SpdSolve elastic, flow;                   // LinearSolver in biot.hpp says which each gets
     bool elastic_iterative = false, flow_iterative = false;
     bool mobility_changed = true;
     Real flow_dt = -1;

@@ -25,7 +25,9 @@ BiotOptions biot_options(const Model& model) {
 }
 
 /// Mean of a tet's nodal tensors.
-Mat3 tet_mean(const Tet& t, const std::vector<Mat3>& nodal) { return 0.25 * (nodal[t[0]] + nodal[t[1]] + nodal[t[2]] + nodal[t[3]]); }
+Mat3 tet_mean(const Tet& t, const std::vector<Mat3>& nodal) {
+    return 0.25 * (nodal[t[0]] + nodal[t[1]] + nodal[t[2]] + nodal[t[3]]);
+}
 
 }  // namespace
 
@@ -33,11 +35,13 @@ TetMesh mesh_points(const Model& model, const std::vector<Vec3>& x, PfemTimings&
     Stopwatch watch;
     const PoroelasticSettings& pe = model.scene.poroelastic;
     MeshOptions options;
-    options.alpha = pe.alpha, options.join_delta = pe.join_delta, options.weighted = pe.weighted_alpha;
+    options.alpha = pe.alpha, options.join_delta = pe.join_delta,
+    options.weighted = pe.weighted_alpha;
     const std::vector<Real> size(x.size(), model.dx);
     // Weighted variant (method.md §5.1): w = (omega_S S + omega_m m/m_bar) (dx/2)^2 with a
     // saturated, uniform-mass solid: S = 1, m = m_bar.
-    const std::vector<Real> weights(options.weighted ? x.size() : 0, (1.0 + 0.2) * 0.25 * model.dx * model.dx);
+    const std::vector<Real> weights(options.weighted ? x.size() : 0,
+                                    (1.0 + 0.2) * 0.25 * model.dx * model.dx);
     TetMesh mesh = build_tet_mesh(x, size, options, weights);
     timings.meshing += watch.seconds();
     return mesh;
@@ -45,22 +49,27 @@ TetMesh mesh_points(const Model& model, const std::vector<Vec3>& x, PfemTimings&
 
 BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
     BiotMaterial b;
-    b.youngs_modulus = m.youngs_modulus, b.poisson_ratio = m.poisson_ratio, b.biot_coefficient = m.biot_coefficient;
+    b.youngs_modulus = m.youngs_modulus, b.poisson_ratio = m.poisson_ratio,
+    b.biot_coefficient = m.biot_coefficient;
     // 1/M = phi/K_f + (B - phi)/K_s (method.md §5.3).
-    b.storage = m.porosity / model.scene.poroelastic.fluid_bulk_modulus + (m.biot_coefficient - m.porosity) / b.grain_bulk_modulus();
+    b.storage = m.porosity / model.scene.poroelastic.fluid_bulk_modulus +
+                (m.biot_coefficient - m.porosity) / b.grain_bulk_modulus();
     b.fluid_density = model.rho0;
     b.bulk_density = (1 - m.porosity) * m.solid_density + m.porosity * model.rho0;  // saturated
     return b;
 }
 
-BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh, const std::vector<Mat3>& node_tensors) {
+BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
+                         const std::vector<Mat3>& node_tensors) {
     BiotProblem p;
     p.material = biot_material(model, solid.material);
     p.gravity = model.scene.gravity;
     p.mobility.resize(mesh.tet_count());
-    for (Index e = 0; e < mesh.tet_count(); ++e) p.mobility[e] = tet_mean(mesh.tets[e], node_tensors) / solid.material.darcy_viscosity;
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        p.mobility[e] = tet_mean(mesh.tets[e], node_tensors) / solid.material.darcy_viscosity;
     const Index n = mesh.node_count();
-    p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0), p.nodal_force.assign(n, Vec3::Zero());
+    p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0),
+        p.nodal_force.assign(n, Vec3::Zero());
     // A node is on a region when inside it or within 3/4 of a spacing: the outer particle layer
     // sits half a spacing inside the geometry, the next one 1.5 spacings.
     const Real reach = 0.75 * model.dx;
@@ -73,8 +82,10 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
         }
         for (Index a = 0; a < n; ++a) {
             if (!inside(mesh.nodes[a])) continue;
-            if (c.kind == Constraint::Kind::Fixed) p.fixed[a] |= c.axes;
-            else p.drained[a] = 1, p.drained_pressure[a] = c.pressure;
+            if (c.kind == Constraint::Kind::Fixed)
+                p.fixed[a] |= c.axes;
+            else
+                p.drained[a] = 1, p.drained_pressure[a] = c.pressure;
         }
     }
     // Nodes touching a static wall (within a spacing of its particle skin) are anchored, u = 0
@@ -82,49 +93,60 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     for (const Wall& w : model.scene.walls)
         for (Index a = 0; a < n; ++a) {
             const Real d = w.shape.signed_distance(mesh.nodes[a]);
-            if (w.kind == Wall::Kind::Obstacle ? d <= model.dx : d >= -model.dx) p.fixed[a] = FixAll;
+            if (w.kind == Wall::Kind::Obstacle ? d <= model.dx : d >= -model.dx)
+                p.fixed[a] = FixAll;
         }
-    p.free_body = std::all_of(p.fixed.begin(), p.fixed.end(), [](std::uint8_t f) { return f == 0; });
+    p.free_body =
+        std::all_of(p.fixed.begin(), p.fixed.end(), [](std::uint8_t f) { return f == 0; });
     return p;
 }
 
-BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem, PfemTimings& timings) {
+BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem,
+                            PfemTimings& timings) {
     BiotSolver solver(mesh, std::move(problem), biot_options(model));
     timings.assembly += solver.seconds_assembly();
     timings.factorisation += solver.seconds_elastic_factorisation();
     return solver;
 }
 
-NodalPoreState nodal_pore_state(const PorousMaterial& material, const BiotMaterial& biot, const NodalStress& stress,
-                                const std::vector<Real>& pressure) {
+NodalPoreState nodal_pore_state(const PorousMaterial& material, const BiotMaterial& biot,
+                                const NodalStress& stress, const std::vector<Real>& pressure) {
     const size_t n = pressure.size();
     NodalPoreState s{std::vector<Real>(n), std::vector<Real>(n)};
     for (size_t a = 0; a < n; ++a) {
-        s.porosity[a] = dynamic_porosity(material.porosity, stress.volumetric_strain[a], pressure[a], biot.grain_bulk_modulus());
-        s.permeability_scale[a] = kozeny_carman_permeability(material.permeability, material.porosity, s.porosity[a]) / material.permeability;
+        s.porosity[a] = dynamic_porosity(material.porosity, stress.volumetric_strain[a],
+                                         pressure[a], biot.grain_bulk_modulus());
+        s.permeability_scale[a] =
+            kozeny_carman_permeability(material.permeability, material.porosity, s.porosity[a]) /
+            material.permeability;
     }
     return s;
 }
 
-void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material, const std::vector<Mat3>& node_tensors,
-                      const std::vector<Real>& node_scale, std::vector<Real>& assembled_scale) {
+void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material,
+                      const std::vector<Mat3>& node_tensors, const std::vector<Real>& node_scale,
+                      std::vector<Real>& assembled_scale) {
     std::vector<Real> tet_scale(mesh.tet_count());
     bool changed = false;
     for (Index e = 0; e < mesh.tet_count(); ++e) {
         const Tet& t = mesh.tets[e];
-        tet_scale[e] = 0.25 * (node_scale[t[0]] + node_scale[t[1]] + node_scale[t[2]] + node_scale[t[3]]);
+        tet_scale[e] =
+            0.25 * (node_scale[t[0]] + node_scale[t[1]] + node_scale[t[2]] + node_scale[t[3]]);
         changed = changed || std::abs(tet_scale[e] / assembled_scale[e] - 1) > 0.01;
     }
     if (!changed) return;
     std::vector<Mat3> mobility(mesh.tet_count());
-    for (Index e = 0; e < mesh.tet_count(); ++e) mobility[e] = (tet_scale[e] / material.darcy_viscosity) * tet_mean(mesh.tets[e], node_tensors);
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        mobility[e] =
+            (tet_scale[e] / material.darcy_viscosity) * tet_mean(mesh.tets[e], node_tensors);
     solver.set_mobility(std::move(mobility));
     assembled_scale = std::move(tet_scale);
 }
 
 void append_arrays(PointSet& into, const PointSet& local) {
     for (const PointArray& array : local.arrays) {
-        auto it = std::find_if(into.arrays.begin(), into.arrays.end(), [&](const PointArray& a) { return a.name == array.name; });
+        auto it = std::find_if(into.arrays.begin(), into.arrays.end(),
+                               [&](const PointArray& a) { return a.name == array.name; });
         if (it == into.arrays.end()) {
             into.arrays.push_back({array.name, array.components, array.integer, {}});
             it = std::prev(into.arrays.end());
@@ -133,8 +155,9 @@ void append_arrays(PointSet& into, const PointSet& local) {
     }
 }
 
-void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem, const BiotFields& fields,
-                       const PorousMaterial& material, const std::vector<Mat3>& node_tensors) {
+void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
+                       const BiotFields& fields, const PorousMaterial& material,
+                       const std::vector<Mat3>& node_tensors) {
     const Index offset = Index(frame.nodes.x.size());
     const Index n = mesh.node_count();
     const NodalStress stress = nodal_stress(mesh, problem.material, fields);
@@ -155,7 +178,8 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
     local.add_scalar("crack_candidate", crack);
     append_arrays(frame.nodes, local);
     frame.nodes.x.insert(frame.nodes.x.end(), mesh.nodes.begin(), mesh.nodes.end());
-    for (const Tet& t : mesh.tets) frame.tets.push_back({t[0] + offset, t[1] + offset, t[2] + offset, t[3] + offset});
+    for (const Tet& t : mesh.tets)
+        frame.tets.push_back({t[0] + offset, t[1] + offset, t[2] + offset, t[3] + offset});
 }
 
 }  // namespace karst

@@ -20,31 +20,35 @@ BiotMaterial biot_material(const Model& model, const PorousMaterial& material);
 /// The Biot problem of `solid` on `mesh`, whose nodes are world positions: mobility from the
 /// nodal tensors K0, the scene's constraints (fixed, drained, traction), and anchors where a
 /// node lies within a spacing of a static wall.
-BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh, const std::vector<Mat3>& node_tensors);
+BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
+                         const std::vector<Mat3>& node_tensors);
 
 /// Builds the solver with the scene's /poroelastic settings and adds its assembly and
 /// factorisation times.
-BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem, PfemTimings& timings);
+BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem,
+                            PfemTimings& timings);
 
 /// Porosity (M23) and permeability scale k/k0 (M24) at every node, from the nodal strain and
 /// the Biot pressure.
 struct NodalPoreState {
     std::vector<Real> porosity, permeability_scale;
 };
-NodalPoreState nodal_pore_state(const PorousMaterial& material, const BiotMaterial& biot, const NodalStress& stress,
-                                const std::vector<Real>& pressure);
+NodalPoreState nodal_pore_state(const PorousMaterial& material, const BiotMaterial& biot,
+                                const NodalStress& stress, const std::vector<Real>& pressure);
 
 /// M24 into the Biot flow: each tet's permeability scale is the mean of its nodes'. H is
 /// reassembled (and the flow matrix refactorised) only when some tet's scale moved by over 1 %
 /// since the last assembly, whose scales `assembled_scale` keeps (all 1 at first).
-void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material, const std::vector<Mat3>& node_tensors,
-                      const std::vector<Real>& node_scale, std::vector<Real>& assembled_scale);
+void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material,
+                      const std::vector<Mat3>& node_tensors, const std::vector<Real>& node_scale,
+                      std::vector<Real>& assembled_scale);
 
 /// Appends the mesh (nodes at `mesh.nodes`, tets) to `frame`, with the point arrays
 /// displacement, pore_pressure, porosity (M23), permeability (M24, 6 components),
 /// effective_stress (6), principal_stress (3) and crack_candidate (sigma'_1 / sigma_t, M25).
-void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem, const BiotFields& fields,
-                       const PorousMaterial& material, const std::vector<Mat3>& node_tensors);
+void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
+                       const BiotFields& fields, const PorousMaterial& material,
+                       const std::vector<Mat3>& node_tensors);
 
 /// Appends the arrays of `local` to those of `into` (by name), creating them for the first solid.
 void append_arrays(PointSet& into, const PointSet& local);

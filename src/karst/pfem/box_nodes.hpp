@@ -17,7 +17,8 @@
 
 namespace karst {
 
-inline std::vector<Vec3> box_lattice_nodes(const Vec3& lo, const Vec3& hi, Real dx, Real jitter_fraction = 0, unsigned seed = 1) {
+inline std::vector<Vec3> box_lattice_nodes(const Vec3& lo, const Vec3& hi, Real dx,
+                                           Real jitter_fraction = 0, unsigned seed = 1) {
     int cells[3];
     Real step[3];
     for (int c = 0; c < 3; ++c) {

@@ -21,11 +21,16 @@ std::vector<ElementLink> face_links(const TetMesh& mesh) {
             faces.push_back({f, e});
         }
     }
-    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.nodes != b.nodes ? a.nodes < b.nodes : a.tet < b.tet; });
+    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
+        return a.nodes != b.nodes ? a.nodes < b.nodes : a.tet < b.tet;
+    });
     std::vector<ElementLink> links;
     for (size_t k = 0; k + 1 < faces.size(); ++k)
-        if (faces[k].nodes == faces[k + 1].nodes) links.push_back({faces[k].tet, faces[k + 1].tet}), ++k;
-    std::sort(links.begin(), links.end(), [](const ElementLink& x, const ElementLink& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+        if (faces[k].nodes == faces[k + 1].nodes)
+            links.push_back({faces[k].tet, faces[k + 1].tet}), ++k;
+    std::sort(links.begin(), links.end(), [](const ElementLink& x, const ElementLink& y) {
+        return x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
     return links;
 }
 

@@ -15,8 +15,8 @@ Real clipped_facet_area(std::span<const Vec3> nodes, const Vec3& x, size_t i, Re
     const Vec3 centre = 0.5 * (x + nodes[i]);
     // A square on the bisector plane, large enough to hold the bounded facet.
     const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
-    std::vector<Vec3> polygon{centre + extent * (u + v), centre + extent * (-u + v), centre + extent * (-u - v),
-                              centre + extent * (u - v)};
+    std::vector<Vec3> polygon{centre + extent * (u + v), centre + extent * (-u + v),
+                              centre + extent * (-u - v), centre + extent * (u - v)};
     std::vector<Vec3> clipped;
     for (size_t j = 0; j < nodes.size() && !polygon.empty(); ++j) {
         if (j == i) continue;
@@ -33,9 +33,11 @@ Real clipped_facet_area(std::span<const Vec3> nodes, const Vec3& x, size_t i, Re
     }
     if (polygon.size() < 3) return 0;
     for (const Vec3& p : polygon)
-        if (std::max(std::abs((p - centre).dot(u)), std::abs((p - centre).dot(v))) > 0.999 * extent) return -1;
+        if (std::max(std::abs((p - centre).dot(u)), std::abs((p - centre).dot(v))) > 0.999 * extent)
+            return -1;
     Vec3 twice_area = Vec3::Zero();
-    for (size_t k = 1; k + 1 < polygon.size(); ++k) twice_area += (polygon[k] - polygon[0]).cross(polygon[k + 1] - polygon[0]);
+    for (size_t k = 1; k + 1 < polygon.size(); ++k)
+        twice_area += (polygon[k] - polygon[0]).cross(polygon[k + 1] - polygon[0]);
     return 0.5 * twice_area.norm();
 }
 
@@ -68,8 +70,8 @@ void laplace_shape(std::span<const Vec3> nodes, const Vec3& x, std::span<Real> N
     for (Real& n : N) n /= sum;
 }
 
-void laplace_shape_and_gradient(std::span<const Vec3> nodes, const Vec3& x, Real step, std::span<Real> N,
-                                std::span<Vec3> gradient) {
+void laplace_shape_and_gradient(std::span<const Vec3> nodes, const Vec3& x, Real step,
+                                std::span<Real> N, std::span<Vec3> gradient) {
     laplace_shape(nodes, x, N);
     std::vector<Real> plus(nodes.size()), minus(nodes.size());
     for (int c = 0; c < 3; ++c) {
@@ -77,7 +79,8 @@ void laplace_shape_and_gradient(std::span<const Vec3> nodes, const Vec3& x, Real
         dx[c] = step;
         laplace_shape(nodes, x + dx, plus);
         laplace_shape(nodes, x - dx, minus);
-        for (size_t i = 0; i < nodes.size(); ++i) gradient[i][c] = (plus[i] - minus[i]) / (2 * step);
+        for (size_t i = 0; i < nodes.size(); ++i)
+            gradient[i][c] = (plus[i] - minus[i]) / (2 * step);
     }
 }
 

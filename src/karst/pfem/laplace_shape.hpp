@@ -19,7 +19,7 @@ void laplace_shape(std::span<const Vec3> nodes, const Vec3& x, std::span<Real> N
 
 /// N_i(x) and grad N_i(x); the gradients by central differences with step `step` (M21 allows
 /// 1e-4 dx).
-void laplace_shape_and_gradient(std::span<const Vec3> nodes, const Vec3& x, Real step, std::span<Real> N,
-                                std::span<Vec3> gradient);
+void laplace_shape_and_gradient(std::span<const Vec3> nodes, const Vec3& x, Real step,
+                                std::span<Real> N, std::span<Vec3> gradient);
 
 }  // namespace karst

@@ -6,7 +6,8 @@
 
 namespace karst {
 
-NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material, const BiotFields& fields) {
+NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
+                         const BiotFields& fields) {
     const Index n = mesh.node_count();
     const Real lambda = material.lame_lambda(), mu = material.shear_modulus();
     std::vector<Mat3> strain(n, Mat3::Zero());
@@ -17,7 +18,8 @@ NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material, cons
         for (Index a : mesh.tets[e]) strain[a] += p.volume * eps, volume[a] += p.volume;
     }
     NodalStress s;
-    s.effective.resize(n), s.total.resize(n), s.principal.resize(n), s.principal_direction.resize(n);
+    s.effective.resize(n), s.total.resize(n), s.principal.resize(n),
+        s.principal_direction.resize(n);
     s.volumetric_strain.resize(n), s.strain_energy.resize(n);
     for (Index a = 0; a < n; ++a) {
         // Nodal strain first, then stress: for a linear material both orders agree.

@@ -5,14 +5,15 @@
 namespace karst {
 
 struct NodalStress {
-    std::vector<Mat3> effective;           ///< sigma' = C : eps, Pa
-    std::vector<Mat3> total;               ///< sigma = sigma' - B p I (Eq. 16), Pa
-    std::vector<Vec3> principal;           ///< eigenvalues of sigma', largest first, Pa
-    std::vector<Vec3> principal_direction; ///< unit eigenvector of the largest (crack normal, M25)
-    std::vector<Real> volumetric_strain;   ///< eps_v, volume-weighted (feeds M23)
-    std::vector<Real> strain_energy;       ///< M26: U_a = 1/2 V_a sigma'_a : eps_a, J
+    std::vector<Mat3> effective;            ///< sigma' = C : eps, Pa
+    std::vector<Mat3> total;                ///< sigma = sigma' - B p I (Eq. 16), Pa
+    std::vector<Vec3> principal;            ///< eigenvalues of sigma', largest first, Pa
+    std::vector<Vec3> principal_direction;  ///< unit eigenvector of the largest (crack normal, M25)
+    std::vector<Real> volumetric_strain;    ///< eps_v, volume-weighted (feeds M23)
+    std::vector<Real> strain_energy;        ///< M26: U_a = 1/2 V_a sigma'_a : eps_a, J
 };
 
-NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material, const BiotFields& fields);
+NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
+                         const BiotFields& fields);
 
 }  // namespace karst

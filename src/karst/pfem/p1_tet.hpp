@@ -8,15 +8,16 @@
 namespace karst {
 
 struct P1Tet {
-    Real volume = 0;               ///< m^3 (positive for a positively oriented tet)
-    std::array<Vec3, 4> grad{};    ///< grad N_a, 1/m
+    Real volume = 0;             ///< m^3 (positive for a positively oriented tet)
+    std::array<Vec3, 4> grad{};  ///< grad N_a, 1/m
 };
 
 inline P1Tet p1_tet(const TetMesh& mesh, Index e) {
     const Tet& t = mesh.tets[e];
     const Vec3& x0 = mesh.nodes[t[0]];
     Mat3 J;
-    J.col(0) = mesh.nodes[t[1]] - x0, J.col(1) = mesh.nodes[t[2]] - x0, J.col(2) = mesh.nodes[t[3]] - x0;
+    J.col(0) = mesh.nodes[t[1]] - x0, J.col(1) = mesh.nodes[t[2]] - x0,
+    J.col(2) = mesh.nodes[t[3]] - x0;
     // x = x0 + J xi, so grad xi_k = row k of J^-1, and N_0 = 1 - xi_1 - xi_2 - xi_3.
     const Mat3 inverse = J.inverse();
     P1Tet p;

@@ -19,7 +19,8 @@ std::vector<PolyhedralElement> polyhedral_elements(const TetMesh& mesh, Real gra
         for (Index e : tets_of[id])
             for (Index a : mesh.tets[e]) element.nodes.push_back(a);
         std::sort(element.nodes.begin(), element.nodes.end());
-        element.nodes.erase(std::unique(element.nodes.begin(), element.nodes.end()), element.nodes.end());
+        element.nodes.erase(std::unique(element.nodes.begin(), element.nodes.end()),
+                            element.nodes.end());
         std::vector<Vec3> x(element.nodes.size());
         for (size_t k = 0; k < x.size(); ++k) x[k] = mesh.nodes[element.nodes[k]];
         for (Index e : tets_of[id]) {
@@ -28,7 +29,8 @@ std::vector<PolyhedralElement> polyhedral_elements(const TetMesh& mesh, Real gra
             point.weight = mesh.tet_volume(e);
             point.N.resize(x.size()), point.grad.resize(x.size());
             const Tet& t = mesh.tets[e];
-            const Vec3 centroid = 0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]);
+            const Vec3 centroid =
+                0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]);
             laplace_shape_and_gradient(x, centroid, gradient_step, point.N, point.grad);
             element.points.push_back(std::move(point));
         }

@@ -8,10 +8,10 @@ namespace karst {
 
 struct PolyhedralElement {
     struct Point {
-        Index tet = 0;            ///< the sub-tet (for its mobility)
-        Real weight = 0;          ///< its volume, m^3
-        std::vector<Real> N;      ///< (nodes)
-        std::vector<Vec3> grad;   ///< (nodes), 1/m
+        Index tet = 0;           ///< the sub-tet (for its mobility)
+        Real weight = 0;         ///< its volume, m^3
+        std::vector<Real> N;     ///< (nodes)
+        std::vector<Vec3> grad;  ///< (nodes), 1/m
     };
     std::vector<Index> nodes;
     std::vector<Point> points;

@@ -10,8 +10,10 @@ namespace karst {
 /// M23 (the paper's Eq. 8, exact): phi = [phi0 + eps_v + (1 - phi0) dp/K_s] / (1 + eps_v),
 /// clamped to [phi_min, 0.95]. eps_v is the volumetric strain from the fragment's rest state and
 /// dp the gauge pore pressure.
-inline Real dynamic_porosity(Real phi0, Real volumetric_strain, Real pressure, Real solid_bulk_modulus, Real phi_min = 1e-3) {
-    const Real phi = (phi0 + volumetric_strain + (1 - phi0) * pressure / solid_bulk_modulus) / (1 + volumetric_strain);
+inline Real dynamic_porosity(Real phi0, Real volumetric_strain, Real pressure,
+                             Real solid_bulk_modulus, Real phi_min = 1e-3) {
+    const Real phi = (phi0 + volumetric_strain + (1 - phi0) * pressure / solid_bulk_modulus) /
+                     (1 + volumetric_strain);
     return std::clamp(phi, phi_min, Real(0.95));
 }
 

@@ -46,7 +46,8 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     e.solver.emplace(make_biot_solver(model, s.mesh, std::move(problem), state.structures.timings));
     e.assembled_scale.assign(s.mesh.tet_count(), 1);
     e.mesh_version = s.mesh_version;
-    refresh_mobility(*e.solver, s.mesh, solid.material, s.node_tensors, s.permeability_scale, e.assembled_scale);
+    refresh_mobility(*e.solver, s.mesh, solid.material, s.node_tensors, s.permeability_scale,
+                     e.assembled_scale);
     return *e.solver;
 }
 
@@ -59,12 +60,14 @@ void build(const Model& model, State& state, size_t slot) {
     std::vector<Vec3> x;
     s.node_id.clear();
     for (Index i = 0; i < p.size(); ++i)
-        if (p.fragment[i] == s.fragment) x.push_back(st.rest_x[p.id[i]]), s.node_id.push_back(p.id[i]);
+        if (p.fragment[i] == s.fragment)
+            x.push_back(st.rest_x[p.id[i]]), s.node_id.push_back(p.id[i]);
     s.mesh = mesh_points(model, x, st.timings);
     s.mesh_version = st.next_mesh_version++;
     s.links = face_links(s.mesh);
     const Index n = s.mesh.node_count();
-    s.node_tensors.resize(n), s.fields.u.resize(n), s.fields.p.assign(n, 0), s.permeability_scale.assign(n, 1);
+    s.node_tensors.resize(n), s.fields.u.resize(n), s.fields.p.assign(n, 0),
+        s.permeability_scale.assign(n, 1);
     for (Index a = 0; a < n; ++a) {
         const Index id = s.node_id[a];
         st.node_of[id] = {Index(slot), a};
@@ -74,11 +77,13 @@ void build(const Model& model, State& state, size_t slot) {
     s.distorted = false;
     const BiotProblem& problem = solver_of(model, state, slot).problem();
     for (Index a = 0; a < n; ++a)
-        if (problem.drained[a]) s.fields.p[a] = problem.drained_pressure.empty() ? 0 : problem.drained_pressure[a];
+        if (problem.drained[a])
+            s.fields.p[a] = problem.drained_pressure.empty() ? 0 : problem.drained_pressure[a];
     s.well_shaped.resize(s.mesh.tet_count());
     for (Index e = 0; e < s.mesh.tet_count(); ++e) {
         const Tet& t = s.mesh.tets[e];
-        s.well_shaped[e] = min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) >= k_distorted_dihedral_deg;
+        s.well_shaped[e] =
+            min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) >= k_distorted_dihedral_deg;
     }
 }
 
@@ -88,7 +93,8 @@ bool distorted(const Structure& s) {
     for (Index e = 0; e < s.mesh.tet_count(); ++e) {
         if (!s.well_shaped[e]) continue;
         const Tet& t = s.mesh.tets[e];
-        if (signed_volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) <= 0 || min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) < k_distorted_dihedral_deg)
+        if (signed_volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) <= 0 ||
+            min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) < k_distorted_dihedral_deg)
             return true;
     }
     return false;
@@ -101,12 +107,14 @@ void build_structures(const Model& model, State& state) {
     const PorousParticles& p = state.porous.particles;
     size_t ids = 0;
     for (Index i = 0; i < p.size(); ++i) ids = std::max<size_t>(ids, size_t(p.id[i]) + 1);
-    st.impulse.assign(ids, Vec3::Zero()), st.u.assign(ids, Vec3::Zero()), st.rest_tensor.assign(ids, Mat3::Zero());
+    st.impulse.assign(ids, Vec3::Zero()), st.u.assign(ids, Vec3::Zero()),
+        st.rest_tensor.assign(ids, Mat3::Zero());
     st.rest_x.assign(ids, Vec3::Zero()), st.node_of.assign(ids, {-1, -1});
     st.paired_scale.assign(ids, 1), st.paired_volume.assign(ids, 0);
     for (Index i = 0; i < p.size(); ++i) {
         const Index id = p.id[i];
-        st.rest_tensor[id] = p.body_permeability[i], st.paired_volume[id] = p.volume[i], st.rest_x[id] = p.x[i];
+        st.rest_tensor[id] = p.body_permeability[i], st.paired_volume[id] = p.volume[i],
+        st.rest_x[id] = p.x[i];
     }
     if (model.coupled() && !model.scene.poroelastic.coupled_fragments) return;
     const std::vector<Fragment>& fragments = state.porous.fragments;
@@ -115,7 +123,8 @@ void build_structures(const Model& model, State& state) {
         Index material = -1;  // the fragment's solid: its members share one material
         for (Index i = 0; i < p.size() && material < 0; ++i)
             if (p.fragment[i] == Index(f)) material = p.material[i];
-        if (model.scene.porous_solids[material].material.porosity < k_min_porosity) continue;  // a rigid boundary
+        if (model.scene.porous_solids[material].material.porosity < k_min_porosity)
+            continue;  // a rigid boundary
         Structure s;
         s.fragment = Index(f), s.solid = material;
         st.structures.push_back(std::move(s));
@@ -139,7 +148,8 @@ void follow_structure_displacement(const Model& model, State& state) {
     // displacement moved the fluid's boundary by up to 2 % of a spacing within one step. The
     // pore-flow pairs need no rebuild for it: their conductances hold the distances between
     // members, which change with the strain (feed_back_structures), not with the displacement.
-    const Real dt_B = model.scene.poroelastic.time_step, fraction = std::min<Real>(1, st.elapsed / dt_B);
+    const Real dt_B = model.scene.poroelastic.time_step,
+               fraction = std::min<Real>(1, st.elapsed / dt_B);
     PorousParticles& p = state.porous.particles;
     parallel_for(p.size(), [&](Index i) {
         const auto [slot, a] = st.node_of[p.id[i]];
@@ -152,7 +162,8 @@ void follow_structure_displacement(const Model& model, State& state) {
 }
 
 bool biot_call_due(const Model& model, const State& state) {
-    return !state.structures.empty() && state.structures.elapsed >= model.scene.poroelastic.time_step * (1 - 1e-9);
+    return !state.structures.empty() &&
+           state.structures.elapsed >= model.scene.poroelastic.time_step * (1 - 1e-9);
 }
 
 Real time_to_next_biot_call(const Model& model, const State& state) {
@@ -174,7 +185,8 @@ void remesh_structures(const Model& model, State& state) {
             // [D] A distorted mesh is rebuilt on the deformed positions, which become the new
             // rest state (u = 0 there): small-strain Biot cannot carry a deformation that inverts
             // elements, so the stress it held is released, as in a soil that has flowed.
-            for (Index a = 0; a < n; ++a) st.rest_x[s.node_id[a]] += s.fields.u[a], st.u[s.node_id[a]] = Vec3::Zero();
+            for (Index a = 0; a < n; ++a)
+                st.rest_x[s.node_id[a]] += s.fields.u[a], st.u[s.node_id[a]] = Vec3::Zero();
         } else {
             continue;
         }
@@ -200,12 +212,14 @@ void solve_structures(const Model& model, State& state) {
             if (i < 0) continue;
             loads[a] = st.impulse[s.node_id[a]] / dt;
             if (from_pore_water && !drained[a])
-                s.fields.p[a] = law.pore_pressure(law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
+                s.fields.p[a] = law.pore_pressure(
+                    law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
         }
         solver.set_extra_loads(loads);
         s.u_from = s.fields.u;  // where the particles are now
         const BiotCallReport r = solver.advance(dt, s.fields);
-        st.timings.factorisation += r.seconds_flow_factorisation, st.timings.iterations += r.seconds_iterations;
+        st.timings.factorisation += r.seconds_flow_factorisation,
+            st.timings.iterations += r.seconds_iterations;
         ++st.timings.biot_calls, st.timings.biot_iterations += r.iterations;
         st.timings.all_converged = st.timings.all_converged && r.converged;
         s.distorted = distorted(s);
@@ -226,7 +240,8 @@ bool feed_back_structures(const Model& model, State& state) {
         BiotSolver& solver = solver_of(model, state, slot);
         const PorousMaterial& material = model.scene.porous_solids[s.solid].material;
         const NodalStress stress = nodal_stress(s.mesh, solver.problem().material, s.fields);
-        const NodalPoreState pore = nodal_pore_state(material, solver.problem().material, stress, s.fields.p);
+        const NodalPoreState pore =
+            nodal_pore_state(material, solver.problem().material, stress, s.fields.p);
         const Mat3 R = state.porous.fragments[s.fragment].rotation_matrix();
         for (Index a = 0; a < s.mesh.node_count(); ++a) {
             const Index i = index_of[s.node_id[a]];
@@ -236,7 +251,8 @@ bool feed_back_structures(const Model& model, State& state) {
             p.body_permeability[i] = pore.permeability_scale[a] * s.node_tensors[a];
             p.permeability[i] = R * p.body_permeability[i] * R.transpose();
             const Index id = s.node_id[a];
-            stale = stale || std::abs(pore.permeability_scale[a] / st.paired_scale[id] - 1) > 0.01 ||
+            stale = stale ||
+                    std::abs(pore.permeability_scale[a] / st.paired_scale[id] - 1) > 0.01 ||
                     std::abs(p.volume[i] / st.paired_volume[id] - 1) > 0.01;
         }
         s.permeability_scale = pore.permeability_scale;
@@ -245,7 +261,9 @@ bool feed_back_structures(const Model& model, State& state) {
     }
     if (stale)
         for (Index i = 0; i < p.size(); ++i)
-            st.paired_scale[p.id[i]] = p.body_permeability[i].trace() / st.rest_tensor[p.id[i]].trace(), st.paired_volume[p.id[i]] = p.volume[i];
+            st.paired_scale[p.id[i]] =
+                p.body_permeability[i].trace() / st.rest_tensor[p.id[i]].trace(),
+            st.paired_volume[p.id[i]] = p.volume[i];
     return stale;
 }
 
@@ -262,7 +280,8 @@ MeshQuality structure_mesh_quality(const State& state) {
     for (const Structure& s : state.structures.structures) {
         const MeshQuality& m = s.mesh.quality;
         q.delaunay_cells += m.delaunay_cells, q.kept += m.kept, q.elements += m.elements;
-        q.slivers_dropped += m.slivers_dropped, q.interior_slivers += m.interior_slivers, q.polyhedra += m.polyhedra;
+        q.slivers_dropped += m.slivers_dropped, q.interior_slivers += m.interior_slivers,
+            q.polyhedra += m.polyhedra;
         q.joined_polyhedra += m.joined_polyhedra, q.volume += m.volume;
     }
     return q;

@@ -21,18 +21,18 @@ struct ElementLink {
 
 /// One anchored fragment's Biot problem.
 struct Structure {
-    Index fragment = 0;                ///< in PorousState::fragments
-    Index solid = 0;                   ///< in scene.porous_solids (its material and constraints)
-    std::int64_t mesh_version = 0;     ///< changes whenever the mesh is rebuilt (keys BiotCache)
-    std::vector<Index> node_id;        ///< porous particle id of each node
-    TetMesh mesh;                      ///< on the rest positions X (world frame: anchored)
-    std::vector<ElementLink> links;    ///< face adjacencies of mesh.tets
-    BiotFields fields;                 ///< u, p of the last call, per node
-    std::vector<Vec3> u_from;          ///< per node: u of the call before the last (the particles' start)
-    std::vector<Mat3> node_tensors;    ///< K0 per node (body frame), m^2
+    Index fragment = 0;              ///< in PorousState::fragments
+    Index solid = 0;                 ///< in scene.porous_solids (its material and constraints)
+    std::int64_t mesh_version = 0;   ///< changes whenever the mesh is rebuilt (keys BiotCache)
+    std::vector<Index> node_id;      ///< porous particle id of each node
+    TetMesh mesh;                    ///< on the rest positions X (world frame: anchored)
+    std::vector<ElementLink> links;  ///< face adjacencies of mesh.tets
+    BiotFields fields;               ///< u, p of the last call, per node
+    std::vector<Vec3> u_from;  ///< per node: u of the call before the last (the particles' start)
+    std::vector<Mat3> node_tensors;        ///< K0 per node (body frame), m^2
     std::vector<Real> permeability_scale;  ///< per node: k/k0 of the last feedback (M24)
-    std::vector<char> well_shaped;     ///< per tet: dihedral angles of at least 2 degrees at rest
-    bool distorted = false;            ///< the last call left a distorted element: remesh before the next
+    std::vector<char> well_shaped;  ///< per tet: dihedral angles of at least 2 degrees at rest
+    bool distorted = false;  ///< the last call left a distorted element: remesh before the next
 };
 
 /// Seconds spent per PFEM phase and what the calls did, summed over structures and calls
@@ -46,13 +46,14 @@ struct PfemTimings {
 struct StructureState {
     std::vector<Structure> structures;
     // Per porous particle id (PorousParticles::id):
-    std::vector<Vec3> impulse;         ///< sum of force dt since the last call, N s
-    std::vector<Vec3> u;               ///< displacement carried over a remesh, m
-    std::vector<Vec3> rest_x;          ///< rest position X (world = body frame when anchored), m
+    std::vector<Vec3> impulse;  ///< sum of force dt since the last call, N s
+    std::vector<Vec3> u;        ///< displacement carried over a remesh, m
+    std::vector<Vec3> rest_x;   ///< rest position X (world = body frame when anchored), m
     std::vector<std::pair<Index, Index>> node_of;  ///< (structure, node), or (-1, -1)
-    std::vector<Mat3> rest_tensor;     ///< K0 in the body frame, m^2
-    std::vector<Real> paired_scale, paired_volume;  ///< k/k0 and V when the pore-flow pairs were built
-    Real elapsed = 0;                  ///< time since the last call, s
+    std::vector<Mat3> rest_tensor;                 ///< K0 in the body frame, m^2
+    std::vector<Real> paired_scale,
+        paired_volume;  ///< k/k0 and V when the pore-flow pairs were built
+    Real elapsed = 0;   ///< time since the last call, s
     std::int64_t next_mesh_version = 0;
     PfemTimings timings;
     bool empty() const { return structures.empty(); }
@@ -65,7 +66,8 @@ public:
     struct Entry {
         std::int64_t mesh_version = -1;
         std::optional<BiotSolver> solver;
-        std::vector<Real> assembled_scale;  ///< per tet: the k/k0 the flow matrix was assembled with
+        std::vector<Real>
+            assembled_scale;  ///< per tet: the k/k0 the flow matrix was assembled with
     };
     BiotCache() = default;
     BiotCache(const BiotCache&) {}
@@ -78,7 +80,8 @@ public:
 
     /// The entry of structure `slot`, or null when it was built on another mesh (or never).
     Entry* find(size_t slot, std::int64_t mesh_version) {
-        if (slot >= m_entries.size() || m_entries[slot].mesh_version != mesh_version) return nullptr;
+        if (slot >= m_entries.size() || m_entries[slot].mesh_version != mesh_version)
+            return nullptr;
         return &m_entries[slot];
     }
     Entry& reset(size_t slot) {

@@ -15,10 +15,10 @@ using Tet = std::array<Index, 4>;
 using Triangle = std::array<Index, 3>;
 
 struct MeshOptions {
-    Real alpha = 1.25;            ///< M19: keep a tet iff its circumradius < alpha * h_e
-    Real join_delta = 0.1;        ///< M20: join face neighbours iff |c1 - c2| < delta * r_rms
-    Real sliver_volume = 1e-3;    ///< §5.1.3: tets with V < sliver_volume * h_e^3 are slivers
-    bool weighted = false;        ///< weighted alpha shape (regular triangulation, orthoradius)
+    Real alpha = 1.25;          ///< M19: keep a tet iff its circumradius < alpha * h_e
+    Real join_delta = 0.1;      ///< M20: join face neighbours iff |c1 - c2| < delta * r_rms
+    Real sliver_volume = 1e-3;  ///< §5.1.3: tets with V < sliver_volume * h_e^3 are slivers
+    bool weighted = false;      ///< weighted alpha shape (regular triangulation, orthoradius)
 };
 
 /// Figures that say how good a mesh is; printed by benchmarks and written to stats.json.
@@ -38,7 +38,7 @@ struct TetMesh {
     std::vector<Vec3> nodes;            ///< the input points, same indices
     std::vector<Tet> tets;              ///< assembled tets, positively oriented
     std::vector<Index> tet_polyhedron;  ///< EDT group of each assembled tet
-    std::vector<Triangle> boundary;     ///< surface of the alpha shape, outward (right-hand) normals
+    std::vector<Triangle> boundary;  ///< surface of the alpha shape, outward (right-hand) normals
     MeshQuality quality;
 
     Index node_count() const { return Index(nodes.size()); }
@@ -51,8 +51,8 @@ struct TetMesh {
 /// Delaunay (or regular, when options.weighted) triangulation of `points`, then the alpha shape
 /// with per-node characteristic sizes `node_size` (M19), sliver removal and EDT joining (M20).
 /// `weights` (squared radii, m^2) are read only for the weighted variant.
-TetMesh build_tet_mesh(std::span<const Vec3> points, std::span<const Real> node_size, const MeshOptions& options,
-                       std::span<const Real> weights = {});
+TetMesh build_tet_mesh(std::span<const Vec3> points, std::span<const Real> node_size,
+                       const MeshOptions& options, std::span<const Real> weights = {});
 
 /// Volume of the tet (a, b, c, d): positive when (b - a, c - a, d - a) is right-handed, m^3.
 Real signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);

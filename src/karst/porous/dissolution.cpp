@@ -16,8 +16,9 @@ Vec3 piece_offset(int piece, Real dx) {
 
 }  // namespace
 
-void mark_exposed(const PorousParticles& porous, const FluidParticles& fluid, const NeighbourLists& porous_fluid, Real h,
-                  Real spacing, std::vector<char>& exposed) {
+void mark_exposed(const PorousParticles& porous, const FluidParticles& fluid,
+                  const NeighbourLists& porous_fluid, Real h, Real spacing,
+                  std::vector<char>& exposed) {
     const Real touch = h * h, crowd = 0.36 * spacing * spacing;
     exposed.assign(porous.size(), 0);
     parallel_for(porous.size(), [&](Index k) {
@@ -31,8 +32,9 @@ void mark_exposed(const PorousParticles& porous, const FluidParticles& fluid, co
     });
 }
 
-DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::span<const PoreWaterLaw> laws,
-                           const DissolutionSettings& settings, std::int64_t& next_id, const std::vector<char>& exposed) {
+DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid,
+                           std::span<const PoreWaterLaw> laws, const DissolutionSettings& settings,
+                           std::int64_t& next_id, const std::vector<char>& exposed) {
     DissolutionReport report;
     std::vector<char> keep(porous.size(), 1);
     for (Index i = 0; i < porous.size(); ++i) {
@@ -41,20 +43,27 @@ DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::
         const PoreWaterLaw& law = laws[porous.material_of(i)];
         const DissolutionThreshold& threshold = settings.thresholds[porous.material_of(i)];
         if (phi < threshold.porosity) continue;
-        if (law.saturation(porous.absorbed_mass[i], phi, porous.volume[i]) < threshold.saturation) continue;
+        if (law.saturation(porous.absorbed_mass[i], phi, porous.volume[i]) < threshold.saturation)
+            continue;
         keep[i] = 0, ++report.dissolved;
-        const Real m = porous.solid_mass[i] + porous.absorbed_mass[i], solute = porous.solid_mass[i];
-        const Real sph_mass = porous.absorbed_mass[i] + solute * law.rest_density / threshold.grain_density;  // rho0 V
-        const int pieces = m > 2 * settings.fluid_particle_mass ? int(std::ceil(m / settings.fluid_particle_mass)) : 1;
+        const Real m = porous.solid_mass[i] + porous.absorbed_mass[i],
+                   solute = porous.solid_mass[i];
+        const Real sph_mass = porous.absorbed_mass[i] +
+                              solute * law.rest_density / threshold.grain_density;  // rho0 V
+        const int pieces = m > 2 * settings.fluid_particle_mass
+                               ? int(std::ceil(m / settings.fluid_particle_mass))
+                               : 1;
         // Equal pieces, the last taking the rounding remainder, so the sums are exact.
         Real mass_left = m, solute_left = solute;
         for (int k = 0; k < pieces; ++k) {
             const bool last = k == pieces - 1;
-            const Real mk = last ? mass_left : m / pieces, sk = last ? solute_left : solute / pieces;
+            const Real mk = last ? mass_left : m / pieces,
+                       sk = last ? solute_left : solute / pieces;
             mass_left -= mk, solute_left -= sk;
             const Index j = fluid.size();
             resize_attributes(fluid, size_t(j) + 1);  // every attribute, zero unless set here
-            fluid.x[j] = porous.x[i] + (pieces > 1 ? piece_offset(k, settings.spacing) : Vec3::Zero());
+            fluid.x[j] =
+                porous.x[i] + (pieces > 1 ? piece_offset(k, settings.spacing) : Vec3::Zero());
             fluid.v[j] = porous.v[i];
             fluid.mass[j] = mk;
             fluid.sph_mass[j] = sph_mass * (mk / m);

@@ -11,15 +11,15 @@ namespace karst {
 
 /// When a material dissolves (per material, like PoreWaterLaw).
 struct DissolutionThreshold {
-    Real saturation = 0.98;      ///< S_diss
-    Real porosity = 0.6;         ///< phi_diss
-    Real grain_density = 2650;   ///< rho_s, kg/m^3: sets the muddy particle's volume
+    Real saturation = 0.98;     ///< S_diss
+    Real porosity = 0.6;        ///< phi_diss
+    Real grain_density = 2650;  ///< rho_s, kg/m^3: sets the muddy particle's volume
 };
 
 struct DissolutionSettings {
     std::vector<DissolutionThreshold> thresholds;  ///< per material (PorousParticles::material)
-    Real fluid_particle_mass;    ///< m_f0 = rho0 dx^3, kg
-    Real spacing;                ///< dx, m (pieces are set 0.1 dx apart)
+    Real fluid_particle_mass;                      ///< m_f0 = rho0 dx^3, kg
+    Real spacing;                                  ///< dx, m (pieces are set 0.1 dx apart)
 };
 
 /// exposed[k] = 1 where a fluid particle (of mass > 0) lies within h of porous particle k and
@@ -28,8 +28,9 @@ struct DissolutionSettings {
 /// into fluid sits in a one-site cavity among boundary particles, and its pressure blew a soaking
 /// block apart (151 m/s within 0.6 s); a fluid particle pressed closer than 0.6 dx would overlap
 /// the new one (0.2 dx was seen), with the same result.
-void mark_exposed(const PorousParticles& porous, const FluidParticles& fluid, const NeighbourLists& porous_fluid, Real h,
-                  Real spacing, std::vector<char>& exposed);
+void mark_exposed(const PorousParticles& porous, const FluidParticles& fluid,
+                  const NeighbourLists& porous_fluid, Real h, Real spacing,
+                  std::vector<char>& exposed);
 
 struct DissolutionReport {
     Index dissolved = 0;      ///< porous particles converted
@@ -43,8 +44,8 @@ struct DissolutionReport {
 /// volumes into one site, 16 % over-dense, and blew it out at 250 m/s]. It is split into
 /// ceil(m / m_f0) pieces when m > 2 m_f0; the porous particle is removed (its fragment must then
 /// update its mass properties and remesh, method.md §4.8). New fluid ids continue from `next_id`.
-DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid, std::span<const PoreWaterLaw> laws,
-                           const DissolutionSettings& settings, std::int64_t& next_id,
-                           const std::vector<char>& exposed = {});
+DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid,
+                           std::span<const PoreWaterLaw> laws, const DissolutionSettings& settings,
+                           std::int64_t& next_id, const std::vector<char>& exposed = {});
 
 }  // namespace karst

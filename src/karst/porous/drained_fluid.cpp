@@ -4,7 +4,8 @@
 
 namespace karst {
 
-Index drain_fluid_particles(FluidParticles& fluid, PorousParticles& porous, const std::vector<Index>& main_receiver,
+Index drain_fluid_particles(FluidParticles& fluid, PorousParticles& porous,
+                            const std::vector<Index>& main_receiver,
                             const NeighbourLists& fluid_fluid, Real full_mass, Real threshold) {
     Index drained = 0;
     // Serial, in index order: a particle's solute may go to a neighbour drained later, which

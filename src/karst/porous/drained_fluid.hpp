@@ -14,12 +14,14 @@
 
 namespace karst {
 
-/// For each fluid particle with water m - m_sol - drained below `threshold` m_f0 and a main receiver
-/// (PoreFlowReport::main_receiver): its water goes to that porous particle, its solute
-/// (as mass and solute) to the nearest fluid neighbour in `fluid_fluid`, and its mass becomes 0
-/// so the integration stage drops it. A particle with solute and no fluid neighbour is kept.
-/// Returns the number of particles drained this way. Totals of water and solute are unchanged.
-Index drain_fluid_particles(FluidParticles& fluid, PorousParticles& porous, const std::vector<Index>& main_receiver,
-                            const NeighbourLists& fluid_fluid, Real full_mass, Real threshold = 0.1);
+/// For each fluid particle with water m - m_sol - drained below `threshold` m_f0 and a main
+/// receiver (PoreFlowReport::main_receiver): its water goes to that porous particle, its solute (as
+/// mass and solute) to the nearest fluid neighbour in `fluid_fluid`, and its mass becomes 0 so the
+/// integration stage drops it. A particle with solute and no fluid neighbour is kept. Returns the
+/// number of particles drained this way. Totals of water and solute are unchanged.
+Index drain_fluid_particles(FluidParticles& fluid, PorousParticles& porous,
+                            const std::vector<Index>& main_receiver,
+                            const NeighbourLists& fluid_fluid, Real full_mass,
+                            Real threshold = 0.1);
 
 }  // namespace karst

@@ -44,7 +44,8 @@ std::vector<PcaFrame> pca_frames(const std::vector<Vec3>& x, Real h) {
 
 Mat3 pca_kernel_tensor(const PcaFrame& frame, Real h) {
     if (!frame.reliable()) return Mat3::Identity() / (0.5 * h);
-    const Real s1 = frame.spread[0], s2 = std::max(frame.spread[1], s1 / 4), s3 = std::max(frame.spread[2], s1 / 4);
+    const Real s1 = frame.spread[0], s2 = std::max(frame.spread[1], s1 / 4),
+               s3 = std::max(frame.spread[2], s1 / 4);
     const Real ks = std::cbrt(1 / (s1 * s2 * s3));
     const Vec3 inverse = Vec3(ks * s1, ks * s2, ks * s3).cwiseInverse();
     return frame.axes * inverse.asDiagonal() * frame.axes.transpose() / h;

@@ -10,8 +10,8 @@ namespace karst {
 
 struct PcaFrame {
     Mat3 axes = Mat3::Identity();  ///< columns: directions of largest, middle and least spread
-    Vec3 spread = Vec3::Ones();    ///< sigma_1 >= sigma_2 >= sigma_3 of the weighted covariance, m^2
-    Index neighbours = 0;          ///< particles within r_i = 2 h, itself included
+    Vec3 spread = Vec3::Ones();  ///< sigma_1 >= sigma_2 >= sigma_3 of the weighted covariance, m^2
+    Index neighbours = 0;        ///< particles within r_i = 2 h, itself included
     /// Enough neighbours (N > N_eps = 25) for the frame to mean anything.
     bool reliable() const { return neighbours > 25; }
     /// The layering normal of a sheet-like neighbourhood: the direction of least spread.

@@ -29,7 +29,9 @@ inline Mat3 world_permeability(Real k, Real k0, const Mat3& rotation, const Mat3
 }
 
 /// det(K)^(1/3), the geometric-mean permeability.
-inline Real mean_permeability(const Mat3& K) { return std::cbrt(K.determinant()); }
+inline Real mean_permeability(const Mat3& K) {
+    return std::cbrt(K.determinant());
+}
 
 /// The anisotropic kernel of a particle (M13, amended): G = h^-1 (K / k_ref)^(-1/2), so that
 /// G^-2 = h^2 K / k_ref, and the pair flux uses k_ref as the scalar permeability.
@@ -42,9 +44,9 @@ inline Real mean_permeability(const Mat3& K) { return std::cbrt(K.determinant())
 /// h (lambda_max / lambda_min)^(1/2); the ratio then measures 4 within a few per cent, at the
 /// cost of more neighbours along the layers.
 struct KernelMetric {
-    Mat3 G;            ///< 1/m
-    Real det_g = 0;    ///< det G, 1/m^3
-    Real k_ref = 0;    ///< m^2
+    Mat3 G;          ///< 1/m
+    Real det_g = 0;  ///< det G, 1/m^3
+    Real k_ref = 0;  ///< m^2
 };
 
 inline KernelMetric kernel_metric(const Mat3& K, Real h) {

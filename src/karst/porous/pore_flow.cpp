@@ -11,7 +11,11 @@
 namespace karst {
 
 PoreFlow::PoreFlow(std::vector<PoreWaterLaw> laws, Real h, Real spacing, PairFlux flux)
-    : m_laws(std::move(laws)), m_h(h), m_spacing(spacing), m_calibration(pair_weight_calibration()), m_flux(flux) {
+    : m_laws(std::move(laws)),
+      m_h(h),
+      m_spacing(spacing),
+      m_calibration(pair_weight_calibration()),
+      m_flux(flux) {
     KARST_CHECK(!m_laws.empty());
 }
 
@@ -21,7 +25,8 @@ void PoreFlow::refresh_metric(const PorousParticles& p, const NeighbourLists* on
     parallel_for(n, [&](Index i) {
         if (only_with && only_with->count[i] == 0) return;
         const KernelMetric metric = kernel_metric(p.permeability[i], m_h);
-        m_G[i] = metric.G, m_det_g[i] = metric.det_g, m_mobility[i] = metric.k_ref / law(p, i).darcy_viscosity;
+        m_G[i] = metric.G, m_det_g[i] = metric.det_g,
+        m_mobility[i] = metric.k_ref / law(p, i).darcy_viscosity;
     });
 }
 
@@ -31,19 +36,24 @@ void PoreFlow::refresh_state(const PorousParticles& p) {
     m_outflow_scale.assign(n, 1);
     parallel_for(n, [&](Index i) {
         const PoreWaterLaw& l = law(p, i);
-        m_saturation[i] = p.porosity[i] >= k_min_porosity ? l.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]) : 0;
+        m_saturation[i] = p.porosity[i] >= k_min_porosity
+                              ? l.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i])
+                              : 0;
         m_potential[i] = l.flow_potential(m_saturation[i], p.x[i]);
-        m_relative_permeability[i] = std::pow(std::min(m_saturation[i], Real(1)), l.saturation_exponent);
+        m_relative_permeability[i] =
+            std::pow(std::min(m_saturation[i], Real(1)), l.saturation_exponent);
     });
 }
 
 Real PoreFlow::pair_weight_between(const PorousParticles& p, Index lo, Index hi) const {
-    if (p.porosity[lo] < k_min_porosity || p.porosity[hi] < k_min_porosity) return 0;  // impermeable (M3)
+    if (p.porosity[lo] < k_min_porosity || p.porosity[hi] < k_min_porosity)
+        return 0;  // impermeable (M3)
     const Vec3 x = p.x[lo] - p.x[hi];
     // Different fragments exchange water only in contact, so an open crack does not conduct.
     if (p.fragment[lo] != p.fragment[hi] && x.norm() >= 1.1 * m_spacing) return 0;
     // M16: the pair weight in the metric of both kernels, calibrated by c_eps.
-    return 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) * m_calibration;
+    return 0.5 * (pair_weight(x, m_G[lo], m_det_g[lo]) + pair_weight(x, m_G[hi], m_det_g[hi])) *
+           m_calibration;
 }
 
 Real PoreFlow::pair_conductance(const PorousParticles& p, Index lo, Index hi, Real weight) const {
@@ -59,7 +69,8 @@ Real PoreFlow::fluid_conductance(const PorousParticles& p, Index k, const Vec3& 
     return p.volume[k] * m * law(p, k).absorption_factor * m_mobility[k] / (m_h * m_h) * F;
 }
 
-PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candidates, PairSelection selection) {
+PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candidates,
+                          PairSelection selection) {
     refresh_metric(p);
     const Index n = p.size();
     const int cap = candidates.capacity;
@@ -69,7 +80,8 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
         int s = 0;
         candidates.for_each(i, [&](Index j) {
             const bool same = p.fragment[i] == p.fragment[j];
-            const bool wanted = selection == PairSelection::All || (selection == PairSelection::SameFragment) == same;
+            const bool wanted = selection == PairSelection::All ||
+                                (selection == PairSelection::SameFragment) == same;
             // (min, max) order: both sides of a pair hold bitwise the same value.
             const Real w = wanted ? pair_weight_between(p, std::min(i, j), std::max(i, j)) : 0;
             weight[i * cap + s++] = w;
@@ -79,7 +91,8 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
     PorePairs out;
     out.start.assign(n + 1, 0);
     for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + kept[i];
-    out.other.resize(out.start[n]), out.conductance.resize(out.start[n]), out.weight.resize(out.start[n]);
+    out.other.resize(out.start[n]), out.conductance.resize(out.start[n]),
+        out.weight.resize(out.start[n]);
     out.row_sum.resize(n);
     parallel_for(n, [&](Index i) {
         Index at = out.start[i];
@@ -100,8 +113,11 @@ PorePairs merge_pairs(const PorePairs& a, const PorePairs& b) {
     PorePairs out;
     const Index n = a.rows();
     out.start.assign(n + 1, 0);
-    for (Index i = 0; i < n; ++i) out.start[i + 1] = out.start[i] + (a.start[i + 1] - a.start[i]) + (b.start[i + 1] - b.start[i]);
-    out.other.reserve(out.start[n]), out.conductance.reserve(out.start[n]), out.weight.reserve(out.start[n]);
+    for (Index i = 0; i < n; ++i)
+        out.start[i + 1] =
+            out.start[i] + (a.start[i + 1] - a.start[i]) + (b.start[i + 1] - b.start[i]);
+    out.other.reserve(out.start[n]), out.conductance.reserve(out.start[n]),
+        out.weight.reserve(out.start[n]);
     out.row_sum.resize(n);
     for (Index i = 0; i < n; ++i) {
         for (const PorePairs* set : {&a, &b})
@@ -123,7 +139,8 @@ void PoreFlow::cache_fluid_conductances(const PorousParticles& p, const FluidExc
         Real sum = 0;
         int s = 0;
         fluid.porous_fluid.for_each(i, [&](Index f) {
-            const Real c = fluid_conductance(p, i, fluid.particles.x[f] - p.x[i], fluid.particles.sph_mass[f]);
+            const Real c =
+                fluid_conductance(p, i, fluid.particles.x[f] - p.x[i], fluid.particles.sph_mass[f]);
             m_fluid_conductance[i * cap + s++] = c;
             sum += c;
         });
@@ -137,7 +154,8 @@ Real PoreFlow::pair_flux(Index i, Index j, Real conductance) const {
     if (dphi == 0 || conductance == 0) return 0;
     // Relative permeability of the donor (larger Phi), upwinded.
     const Index donor = dphi > 0 ? hi : lo;
-    const Real into_lo = conductance * m_relative_permeability[donor] * dphi * m_outflow_scale[donor];
+    const Real into_lo =
+        conductance * m_relative_permeability[donor] * dphi * m_outflow_scale[donor];
     return i == lo ? into_lo : -into_lo;
 }
 
@@ -153,16 +171,19 @@ void PoreFlow::fluid_pair_fluxes(const PorousParticles& p, const FluidExchange& 
             const Real dphi = m_fluid_potential[f] - m_potential[k];
             Real q = 0;
             if (c[s] > 0 && dphi != 0) {
-                if (dphi > 0) q = c[s] * dphi * m_fluid_donor_scale[f];  // the fluid gives, k_r = 1 (S = 1)
+                if (dphi > 0)
+                    q = c[s] * dphi * m_fluid_donor_scale[f];  // the fluid gives, k_r = 1 (S = 1)
                 else  // the porous particle gives back, k_r of its own S, to a fluid receiver
-                    q = c[s] * m_relative_permeability[k] * dphi * m_outflow_scale[k] * m_fluid_receiver_scale[f];
+                    q = c[s] * m_relative_permeability[k] * dphi * m_outflow_scale[k] *
+                        m_fluid_receiver_scale[f];
             }
             flux[s++] = q;
         });
     });
 }
 
-Real PoreFlow::paper_pair_flux(const PorousParticles& p, const PorePairs& pairs, Index i, Index s) const {
+Real PoreFlow::paper_pair_flux(const PorousParticles& p, const PorePairs& pairs, Index i,
+                               Index s) const {
     const Index j = pairs.other[s];
     const Index lo = std::min(i, j), hi = std::max(i, j);
     const Vec3 x = p.x[lo] - p.x[hi];
@@ -172,13 +193,15 @@ Real PoreFlow::paper_pair_flux(const PorousParticles& p, const PorePairs& pairs,
     const Real d = 0.5 * (std::abs(m_pore_velocity[lo].dot(r)) * m_relative_permeability[lo] +
                           std::abs(m_pore_velocity[hi].dot(r)) * m_relative_permeability[hi]);
     const Real into_lo = d / m_h * p.volume[lo] * p.volume[hi] *
-                         (p.absorbed_mass[hi] / p.volume[hi] - p.absorbed_mass[lo] / p.volume[lo]) * pairs.weight[s];
+                         (p.absorbed_mass[hi] / p.volume[hi] - p.absorbed_mass[lo] / p.volume[lo]) *
+                         pairs.weight[s];
     const Index donor = into_lo > 0 ? hi : lo;
     const Real q = into_lo * m_outflow_scale[donor];
     return i == lo ? q : -q;
 }
 
-void PoreFlow::pore_velocities(const PorousParticles& p, const PorePairs& pairs, const std::vector<Index>& rows) {
+void PoreFlow::pore_velocities(const PorousParticles& p, const PorePairs& pairs,
+                               const std::vector<Index>& rows) {
     // M17: v_p = -(k_r K / (phi eta)) grad Phi, grad Phi = sum_j V_j (Phi_j - Phi_i) grad W_ij.
     const CubicKernel W(m_h);
     m_pore_velocity.assign(p.size(), Vec3::Zero());
@@ -188,22 +211,28 @@ void PoreFlow::pore_velocities(const PorousParticles& p, const PorePairs& pairs,
         Vec3 grad = Vec3::Zero();
         for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) {
             const Index j = pairs.other[s];
-            if (p.fragment[j] == p.fragment[i]) grad += p.volume[j] * (m_potential[j] - m_potential[i]) * W.gradient(p.x[i] - p.x[j]);
+            if (p.fragment[j] == p.fragment[i])
+                grad +=
+                    p.volume[j] * (m_potential[j] - m_potential[i]) * W.gradient(p.x[i] - p.x[j]);
         }
-        m_pore_velocity[i] = law(p, i).pore_velocity(m_relative_permeability[i], p.porosity[i], p.permeability[i], grad);
+        m_pore_velocity[i] = law(p, i).pore_velocity(m_relative_permeability[i], p.porosity[i],
+                                                     p.permeability[i], grad);
     });
 }
 
 template <class F>
-void PoreFlow::for_each_pair(const PorousParticles& p, const PorePairs& pairs, Index i, const F& f) const {
+void PoreFlow::for_each_pair(const PorousParticles& p, const PorePairs& pairs, Index i,
+                             const F& f) const {
     for (Index s = pairs.start[i]; s < pairs.start[i + 1]; ++s) {
         const Index j = pairs.other[s];
         if (!(m_wet.empty() || m_wet[i] || m_wet[j])) continue;
-        f(m_flux == PairFlux::PaperEq20 ? paper_pair_flux(p, pairs, i, s) : pair_flux(i, j, pairs.conductance[s]));
+        f(m_flux == PairFlux::PaperEq20 ? paper_pair_flux(p, pairs, i, s)
+                                        : pair_flux(i, j, pairs.conductance[s]));
     }
 }
 
-void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours, std::vector<Real>& rate) {
+void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours,
+                     std::vector<Real>& rate) {
     const PorePairs pair_set = pairs(p, neighbours);
     refresh_state(p);
     m_wet.clear();
@@ -215,21 +244,24 @@ void PoreFlow::rates(const PorousParticles& p, const NeighbourLists& neighbours,
     });
 }
 
-PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neighbours, Real dt, FluidExchange* fluid) {
+PoreFlowReport PoreFlow::advance(PorousParticles& p, const NeighbourLists& neighbours, Real dt,
+                                 FluidExchange* fluid) {
     return advance(p, pairs(p, neighbours), dt, fluid);
 }
 
-PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours, Real dt, FluidExchange* fluid) {
+PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours, Real dt,
+                                 FluidExchange* fluid) {
     PoreFlowReport report;
     const Index n = p.size();
     const Index nf = fluid ? fluid->particles.size() : 0;
     const int cap = fluid ? fluid->porous_fluid.capacity : 0;
-    auto for_each_fluid_pair = [&](const auto& f) {  // serial, in (porous, slot) order: deterministic
-        if (!fluid) return;
-        for (Index k = 0; k < n; ++k)
-            for (int s = 0; s < fluid->porous_fluid.count[k]; ++s)
-                f(k, Index(fluid->porous_fluid.index[k * cap + s]), size_t(k * cap + s));
-    };
+    auto for_each_fluid_pair =
+        [&](const auto& f) {  // serial, in (porous, slot) order: deterministic
+            if (!fluid) return;
+            for (Index k = 0; k < n; ++k)
+                for (int s = 0; s < fluid->porous_fluid.count[k]; ++s)
+                    f(k, Index(fluid->porous_fluid.index[k * cap + s]), size_t(k * cap + s));
+        };
     // Positions, tensors and volumes hold for the whole step: the pair conductances are
     // computed once, and each sub-step only re-reads S and Phi. The kernel metric is needed
     // only where fluid partners are (the porous pairs came with their conductances).
@@ -241,7 +273,8 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         m_fluid_potential.resize(nf);
         const PoreWaterLaw& l = m_laws[0];
         parallel_for(nf, [&](Index f) {
-            m_fluid_potential[f] = std::max(fluid->particles.pressure(f), Real(0)) - l.rest_density * l.gravity.dot(fluid->particles.x[f]);
+            m_fluid_potential[f] = std::max(fluid->particles.pressure(f), Real(0)) -
+                                   l.rest_density * l.gravity.dot(fluid->particles.x[f]);
         });
         m_fluid_transfer.assign(size_t(n) * cap, 0);
     }
@@ -258,11 +291,13 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         // exactly; only the rows of wet particles and their partners are visited.
         m_wet.resize(n);
         std::fill(active.begin(), active.end(), 0);
-        for (Index i = 0; i < n; ++i) m_wet[i] = m_saturation[i] > 1e-6 || (fluid && fluid->porous_fluid.count[i] > 0);
+        for (Index i = 0; i < n; ++i)
+            m_wet[i] = m_saturation[i] > 1e-6 || (fluid && fluid->porous_fluid.count[i] > 0);
         for (Index i = 0; i < n; ++i) {
             if (!m_wet[i]) continue;
             active[i] = 1;
-            for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s) active[neighbours.other[s]] = 1;
+            for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s)
+                active[neighbours.other[s]] = 1;
         }
         rows.clear();
         for (Index i = 0; i < n; ++i)
@@ -276,14 +311,17 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
             const Index i = rows[r];
             if (p.porosity[i] < k_min_porosity) return Real(0);
             const PoreWaterLaw& l = law(p, i);
-            const Real dphi_dm = l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
-            if (m_flux == PairFlux::Darcy) return (neighbours.row_sum[i] + m_fluid_conductance_sum[i]) * dphi_dm;
+            const Real dphi_dm =
+                l.potential_slope(m_saturation[i]) / (l.rest_density * p.porosity[i] * p.volume[i]);
+            if (m_flux == PairFlux::Darcy)
+                return (neighbours.row_sum[i] + m_fluid_conductance_sum[i]) * dphi_dm;
             // Eq. 20 diffuses m_p / V: stable for dt sum_j (d_ij / h) V_j F_ij <= 1, with
             // d_ij <= (|v_pi| + |v_pj|) / 2; fluid pairs as for M15.
             Real sum = 0;
             for (Index s = neighbours.start[i]; s < neighbours.start[i + 1]; ++s) {
                 const Index j = neighbours.other[s];
-                sum += 0.5 * (m_pore_velocity[i].norm() + m_pore_velocity[j].norm()) / m_h * p.volume[j] * neighbours.weight[s];
+                sum += 0.5 * (m_pore_velocity[i].norm() + m_pore_velocity[j].norm()) / m_h *
+                       p.volume[j] * neighbours.weight[s];
             }
             return sum + m_fluid_conductance_sum[i] * dphi_dm;
         });
@@ -301,7 +339,8 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
             parallel_for(nr, [&](Index r) {
                 const Index i = rows[r];
                 Real out = 0, sum = 0;
-                for_each_pair(p, neighbours, i, [&](Real q) { sum += q, out += std::max(-q, Real(0)); });
+                for_each_pair(p, neighbours, i,
+                              [&](Real q) { sum += q, out += std::max(-q, Real(0)); });
                 if (fluid)
                     for (int s = 0; s < fluid->porous_fluid.count[i]; ++s) {
                         const Real q = m_fluid_flux[i * cap + s];
@@ -313,7 +352,8 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         };
         std::fill(rate.begin(), rate.end(), 0), std::fill(outflow.begin(), outflow.end(), 0);
         sum_rates(true);
-        std::fill(fluid_out.begin(), fluid_out.end(), 0), std::fill(fluid_in.begin(), fluid_in.end(), 0);
+        std::fill(fluid_out.begin(), fluid_out.end(), 0),
+            std::fill(fluid_in.begin(), fluid_in.end(), 0);
         for_each_fluid_pair([&](Index, Index f, size_t slot) {
             const Real q = m_fluid_flux[slot];
             (q > 0 ? fluid_out[f] : fluid_in[f]) += std::abs(q);
@@ -333,17 +373,21 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
                     m_fluid_donor_scale[f] = std::max(water, Real(0)) / (fluid_out[f] * h_sub);
                     ++report.limited_donors, fluid_limited = true;
                 }
-                if (fluid_in[f] * h_sub > room) m_fluid_receiver_scale[f] = room / (fluid_in[f] * h_sub), fluid_limited = true;
+                if (fluid_in[f] * h_sub > room)
+                    m_fluid_receiver_scale[f] = room / (fluid_in[f] * h_sub), fluid_limited = true;
             }
             if (limited || fluid_limited) fluid_pair_fluxes(p, *fluid);  // again, with the scales
         }
         if (limited || fluid_limited) sum_rates(false);
-        for (Index i = 0; i < n; ++i) p.absorbed_mass[i] = std::max(p.absorbed_mass[i] + h_sub * rate[i], Real(0));
+        for (Index i = 0; i < n; ++i)
+            p.absorbed_mass[i] = std::max(p.absorbed_mass[i] + h_sub * rate[i], Real(0));
         for_each_fluid_pair([&](Index, Index f, size_t slot) {
             const Real dm = h_sub * m_fluid_flux[slot];  // into the porous particle
             Real& drained = fluid->particles.drained[f];
             drained += dm;
-            if (drained < 0) fluid->particles.mass[f] -= drained, fluid->particles.sph_mass[f] -= drained, drained = 0;  // back-flow beyond what it gave
+            if (drained < 0)
+                fluid->particles.mass[f] -= drained, fluid->particles.sph_mass[f] -= drained,
+                    drained = 0;  // back-flow beyond what it gave
             m_fluid_transfer[slot] += dm;
             report.absorbed += dm;
         });
@@ -356,7 +400,8 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         report.main_receiver.assign(nf, -1);
         std::vector<Real> most(nf, 0);
         for_each_fluid_pair([&](Index k, Index f, size_t slot) {
-            if (m_fluid_transfer[slot] > most[f]) most[f] = m_fluid_transfer[slot], report.main_receiver[f] = k;
+            if (m_fluid_transfer[slot] > most[f])
+                most[f] = m_fluid_transfer[slot], report.main_receiver[f] = k;
         });
     }
     return report;

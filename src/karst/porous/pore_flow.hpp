@@ -21,9 +21,9 @@ struct PoreFlowReport {
 };
 
 /// The fluid particles taking part in the pore flow (§4.7.3): each is a pore-water donor or
-/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6, p the fluid's pressure()), volume m / rho0. A donor's water
-/// goes into `drained` (the SPH mass stays until the particle is deleted); water received
-/// first refills `drained`, then adds to the mass up to m_f0.
+/// receiver with S = 1 and Phi = max(p, 0) - rho0 g.x (M6, p the fluid's pressure()), volume m /
+/// rho0. A donor's water goes into `drained` (the SPH mass stays until the particle is deleted);
+/// water received first refills `drained`, then adds to the mass up to m_f0.
 struct FluidExchange {
     FluidParticles& particles;           ///< mass, sph_mass and drained change
     const NeighbourLists& porous_fluid;  ///< per porous particle: its fluid partners
@@ -66,20 +66,25 @@ public:
                            FluidExchange* fluid = nullptr);
     /// The same with the pairs built beforehand (pairs()), which stay valid while positions
     /// within a fragment, volumes, porosities and tensors (up to rotation) do not change.
-    PoreFlowReport advance(PorousParticles& particles, const PorePairs& pairs, Real dt, FluidExchange* fluid = nullptr);
+    PoreFlowReport advance(PorousParticles& particles, const PorePairs& pairs, Real dt,
+                           FluidExchange* fluid = nullptr);
 
     /// The candidate pairs with a non-zero conductance, `selection` of them.
     PorePairs pairs(const PorousParticles& particles, const NeighbourLists& candidates,
                     PairSelection selection = PairSelection::All);
 
     /// Net pore-water rate into each particle (kg/s) at the current state, for tests.
-    void rates(const PorousParticles& particles, const NeighbourLists& neighbours, std::vector<Real>& rate);
+    void rates(const PorousParticles& particles, const NeighbourLists& neighbours,
+               std::vector<Real>& rate);
 
 private:
-    const PoreWaterLaw& law(const PorousParticles& p, Index i) const { return m_laws[p.material_of(i)]; }
+    const PoreWaterLaw& law(const PorousParticles& p, Index i) const {
+        return m_laws[p.material_of(i)];
+    }
     /// Per particle (those with partners in `only_with`, if given): G (M13), det G and the
     /// mobility k_ref / eta.
-    void refresh_metric(const PorousParticles& particles, const NeighbourLists* only_with = nullptr);
+    void refresh_metric(const PorousParticles& particles,
+                        const NeighbourLists* only_with = nullptr);
     /// Per particle: S (M3), Phi (M6) and k_r; limiter scales back to 1.
     void refresh_state(const PorousParticles& particles);
     /// rho0 V_lo V_hi (k/eta)_pair F / h^2 of M15 (lo < hi) for the pair weight F, kg/(s Pa)
@@ -88,7 +93,8 @@ private:
     /// F_lo,hi of M16 in the metric of both kernels, calibrated (1/m^3); 0 for impermeable
     /// particles and for fragments not in contact.
     Real pair_weight_between(const PorousParticles& particles, Index lo, Index hi) const;
-    /// Conductance of porous k with a fluid particle of volume m / rho0 at offset x (M15, fluid pair).
+    /// Conductance of porous k with a fluid particle of volume m / rho0 at offset x (M15, fluid
+    /// pair).
     Real fluid_conductance(const PorousParticles& particles, Index k, const Vec3& x, Real m) const;
     /// Each fluid pair's conductance in the slots of fluid.porous_fluid, and their sum per
     /// porous particle (for the sub-step limit).
@@ -97,12 +103,15 @@ private:
     /// flux computed from either side is bitwise the same and mass is conserved exactly.
     Real pair_flux(Index i, Index j, Real conductance) const;
     /// The paper's Eq. 20 (conservative form) for the pair in slot s of row i.
-    Real paper_pair_flux(const PorousParticles& particles, const PorePairs& pairs, Index i, Index s) const;
+    Real paper_pair_flux(const PorousParticles& particles, const PorePairs& pairs, Index i,
+                         Index s) const;
     /// M17 pore velocities of the listed rows (for the paper's Eq. 20).
-    void pore_velocities(const PorousParticles& particles, const PorePairs& pairs, const std::vector<Index>& rows);
+    void pore_velocities(const PorousParticles& particles, const PorePairs& pairs,
+                         const std::vector<Index>& rows);
     /// Calls f(q_{j->i}) for every partner j of i.
     template <class F>
-    void for_each_pair(const PorousParticles& particles, const PorePairs& pairs, Index i, const F& f) const;
+    void for_each_pair(const PorousParticles& particles, const PorePairs& pairs, Index i,
+                       const F& f) const;
     /// Flux into each porous particle from each listed fluid particle (kg/s), in the slots of
     /// fluid.porous_fluid, with the current limiter scales.
     void fluid_pair_fluxes(const PorousParticles& particles, const FluidExchange& fluid);
@@ -115,11 +124,12 @@ private:
     std::vector<Real> m_det_g, m_mobility, m_saturation, m_potential, m_outflow_scale;
     std::vector<Real> m_relative_permeability;  ///< k_r = min(S, 1)^beta per particle
     std::vector<char> m_wet;                    ///< S > 1e-6 or touching fluid (empty: all)
-    std::vector<Real> m_fluid_potential;                 ///< per fluid particle, Pa
+    std::vector<Real> m_fluid_potential;        ///< per fluid particle, Pa
     std::vector<Real> m_fluid_donor_scale, m_fluid_receiver_scale;  ///< per fluid particle, limiter
-    std::vector<Real> m_fluid_flux, m_fluid_transfer;    ///< per porous-fluid slot: kg/s, kg this step
-    std::vector<Real> m_fluid_conductance;               ///< per porous-fluid slot, kg/(s Pa)
-    std::vector<Real> m_fluid_conductance_sum;           ///< per porous particle, kg/(s Pa)
+    std::vector<Real> m_fluid_flux,
+        m_fluid_transfer;                       ///< per porous-fluid slot: kg/s, kg this step
+    std::vector<Real> m_fluid_conductance;      ///< per porous-fluid slot, kg/(s Pa)
+    std::vector<Real> m_fluid_conductance_sum;  ///< per porous particle, kg/(s Pa)
 };
 
 }  // namespace karst

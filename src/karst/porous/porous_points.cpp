@@ -7,12 +7,15 @@
 
 namespace karst {
 
-PointSet porous_points(const PorousParticles& p, std::span<const PoreWaterLaw> laws, const NeighbourLists& pairs, Real h) {
+PointSet porous_points(const PorousParticles& p, std::span<const PoreWaterLaw> laws,
+                       const NeighbourLists& pairs, Real h) {
     const Index n = p.size();
     std::vector<Real> S(n), pore_pressure(n), potential(n);
     parallel_for(n, [&](Index i) {
         const PoreWaterLaw& law = laws[p.material_of(i)];
-        S[i] = p.porosity[i] >= k_min_porosity ? law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]) : 0;
+        S[i] = p.porosity[i] >= k_min_porosity
+                   ? law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i])
+                   : 0;
         pore_pressure[i] = law.pore_pressure(S[i]);
         potential[i] = law.flow_potential(S[i], p.x[i]);
     });

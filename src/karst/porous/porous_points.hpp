@@ -12,7 +12,7 @@ namespace karst {
 /// fragment and permeability (6 components). `pairs` lists porous neighbours within at least
 /// the support radius `h`; M17's gradient uses the isotropic cubic kernel over neighbours of the
 /// same fragment.
-PointSet porous_points(const PorousParticles& particles, std::span<const PoreWaterLaw> laws, const NeighbourLists& pairs,
-                       Real h);
+PointSet porous_points(const PorousParticles& particles, std::span<const PoreWaterLaw> laws,
+                       const NeighbourLists& pairs, Real h);
 
 }  // namespace karst

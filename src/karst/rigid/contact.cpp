@@ -7,7 +7,8 @@
 
 namespace karst {
 
-ContactLaw ContactLaw::for_fragments(Real spacing, Real fragment_mass, Real gravity, Real particle_mass, Real restitution) {
+ContactLaw ContactLaw::for_fragments(Real spacing, Real fragment_mass, Real gravity,
+                                     Real particle_mass, Real restitution) {
     ContactLaw law;
     law.rest_distance = spacing;
     law.stiffness = fragment_mass * gravity / (0.01 * spacing);
@@ -18,8 +19,8 @@ ContactLaw ContactLaw::for_fragments(Real spacing, Real fragment_mass, Real grav
     return law;
 }
 
-Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbours, const ContactLaw& law,
-                         std::vector<Vec3>& force) {
+Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbours,
+                         const ContactLaw& law, std::vector<Vec3>& force) {
     std::vector<Index> touching(p.size(), 0);
     parallel_for(p.size(), [&](Index i) {
         Vec3 sum = Vec3::Zero();
@@ -40,8 +41,9 @@ Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbo
     return pairs / 2;
 }
 
-Index add_wall_contact_forces(const PorousParticles& p, const NeighbourLists& walls, const std::vector<Vec3>& wall_x,
-                              const ContactLaw& law, std::vector<Vec3>& force) {
+Index add_wall_contact_forces(const PorousParticles& p, const NeighbourLists& walls,
+                              const std::vector<Vec3>& wall_x, const ContactLaw& law,
+                              std::vector<Vec3>& force) {
     std::vector<Index> touching(p.size(), 0);
     parallel_for(p.size(), [&](Index i) {
         Vec3 sum = Vec3::Zero();

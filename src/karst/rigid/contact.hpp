@@ -14,7 +14,8 @@ struct ContactLaw {
     Real damping = 0;           ///< c_c, N s/m
     /// k_c = M g / (0.01 dx) for the lightest fragment M in contact (method.md §4.2), and the
     /// damping that gives a normal restitution e for two particles of mass m_pair each.
-    static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity, Real particle_mass, Real restitution = 0.2);
+    static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity,
+                                    Real particle_mass, Real restitution = 0.2);
     /// The spring on particle a from b at offset x = x_a - x_b with relative velocity
     /// v = v_a - v_b (N), for 0 < |x| < d0.
     Vec3 force(const Vec3& x, const Vec3& v) const {
@@ -26,12 +27,14 @@ struct ContactLaw {
 
 /// Adds the contact forces (N) into `force` (one per particle); `neighbours` lists particles
 /// within at least d0 (any fragment). Returns the number of touching pairs.
-Index add_contact_forces(const PorousParticles& particles, const NeighbourLists& neighbours, const ContactLaw& law,
-                         std::vector<Vec3>& force);
+Index add_contact_forces(const PorousParticles& particles, const NeighbourLists& neighbours,
+                         const ContactLaw& law, std::vector<Vec3>& force);
 
 /// The same springs against static wall particles at `wall_x` (the walls take no reaction);
-/// `walls` lists, per porous particle, wall particles within at least d0. Returns the touching pairs.
-Index add_wall_contact_forces(const PorousParticles& particles, const NeighbourLists& walls, const std::vector<Vec3>& wall_x,
-                              const ContactLaw& law, std::vector<Vec3>& force);
+/// `walls` lists, per porous particle, wall particles within at least d0. Returns the touching
+/// pairs.
+Index add_wall_contact_forces(const PorousParticles& particles, const NeighbourLists& walls,
+                              const std::vector<Vec3>& wall_x, const ContactLaw& law,
+                              std::vector<Vec3>& force);
 
 }  // namespace karst

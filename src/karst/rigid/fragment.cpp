@@ -6,9 +6,12 @@
 
 namespace karst {
 
-Vec3 Fragment::angular_velocity() const { return world_inertia().inverse() * angular_momentum; }
+Vec3 Fragment::angular_velocity() const {
+    return world_inertia().inverse() * angular_momentum;
+}
 
-Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, std::vector<Vec3>& body_positions, Real spacing) {
+Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass,
+                          std::vector<Vec3>& body_positions, Real spacing) {
     KARST_CHECK(x.size() == mass.size() && !x.empty());
     Fragment f;
     Vec3 moment = Vec3::Zero();

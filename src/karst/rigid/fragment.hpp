@@ -13,21 +13,26 @@
 namespace karst {
 
 struct Fragment {
-    Vec3 centre = Vec3::Zero();                          ///< c, m
+    Vec3 centre = Vec3::Zero();                                    ///< c, m
     Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  ///< q: body -> world
-    Vec3 velocity = Vec3::Zero();                        ///< v, m/s
-    Vec3 angular_momentum = Vec3::Zero();                ///< L, kg m^2/s (world)
-    Real mass = 0;                                       ///< M, kg
-    Mat3 body_inertia = Mat3::Identity();                ///< I0 about c, body frame, kg m^2
+    Vec3 velocity = Vec3::Zero();                                  ///< v, m/s
+    Vec3 angular_momentum = Vec3::Zero();                          ///< L, kg m^2/s (world)
+    Real mass = 0;                                                 ///< M, kg
+    Mat3 body_inertia = Mat3::Identity();  ///< I0 about c, body frame, kg m^2
     bool anchored = false;
 
     Mat3 rotation_matrix() const { return rotation.toRotationMatrix(); }
     /// I_w = R I0 R^T.
-    Mat3 world_inertia() const { const Mat3 R = rotation_matrix(); return R * body_inertia * R.transpose(); }
+    Mat3 world_inertia() const {
+        const Mat3 R = rotation_matrix();
+        return R * body_inertia * R.transpose();
+    }
     /// omega = I_w^-1 L.
     Vec3 angular_velocity() const;
     /// v + omega x (x - c): the velocity of a member at world position x.
-    Vec3 point_velocity(const Vec3& x) const { return velocity + angular_velocity().cross(x - centre); }
+    Vec3 point_velocity(const Vec3& x) const {
+        return velocity + angular_velocity().cross(x - centre);
+    }
 };
 
 /// Mass, centre and body inertia I0 = sum m (|X|^2 I - X X^T + s^2/6 I) of members with masses
@@ -35,8 +40,8 @@ struct Fragment {
 /// the edge of the cube each member fills (its own inertia m s^2/6 keeps I0 invertible for one
 /// or a line of members). Returns the fragment at rest, and writes each member's body-frame
 /// position X = x - c.
-Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass, std::vector<Vec3>& body_positions,
-                          Real spacing = 0);
+Fragment fragment_at_rest(std::span<const Vec3> x, std::span<const Real> mass,
+                          std::vector<Vec3>& body_positions, Real spacing = 0);
 
 /// One member's share of I0: m (|X|^2 I - X X^T + s^2/6 I).
 inline Mat3 member_inertia(Real m, const Vec3& X, Real spacing) {

@@ -31,7 +31,8 @@ ContactLaw fragment_contact_law(const Model& model, const State& state) {
         none.rest_distance = model.dx;
         return none;
     }
-    const Real g = std::max(model.scene.gravity.norm(), Real(9.81));  // weightless scenes still collide
+    const Real g =
+        std::max(model.scene.gravity.norm(), Real(9.81));  // weightless scenes still collide
     return ContactLaw::for_fragments(model.dx, lightest, g, 2 * lightest);
 }
 
@@ -60,7 +61,8 @@ void advance_fragments(const Model& model, State& state, Real dt) {
     std::vector<Vec3> omega(nf);
     for (size_t f = 0; f < nf; ++f) {
         Fragment& fr = fragments[f];
-        if (fr.mass > 0 && !fr.anchored) integrate_fragment(fr, force[f] + fr.mass * model.scene.gravity, torque[f], dt);
+        if (fr.mass > 0 && !fr.anchored)
+            integrate_fragment(fr, force[f] + fr.mass * model.scene.gravity, torque[f], dt);
         rotation[f] = fr.rotation_matrix();
         omega[f] = fr.mass > 0 ? fr.angular_velocity() : Vec3::Zero();
     }

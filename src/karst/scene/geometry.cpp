@@ -32,9 +32,12 @@ Real cylinder_distance(const Vec3& x, const Vec3& base, const Vec3& top, Real r)
 
 Real Shape::signed_distance(const Vec3& x) const {
     switch (kind) {
-        case Kind::Box: return box_distance(x, a, b);
-        case Kind::Sphere: return (x - a).norm() - radius;
-        case Kind::Cylinder: return cylinder_distance(x, a, b, radius);
+        case Kind::Box:
+            return box_distance(x, a, b);
+        case Kind::Sphere:
+            return (x - a).norm() - radius;
+        case Kind::Cylinder:
+            return cylinder_distance(x, a, b, radius);
         case Kind::Union: {
             Real d = std::numeric_limits<Real>::infinity();
             for (const Shape& c : children) d = std::min(d, c.signed_distance(x));
@@ -42,7 +45,8 @@ Real Shape::signed_distance(const Vec3& x) const {
         }
         case Kind::Difference: {
             Real d = children.front().signed_distance(x);
-            for (size_t i = 1; i < children.size(); ++i) d = std::max(d, -children[i].signed_distance(x));
+            for (size_t i = 1; i < children.size(); ++i)
+                d = std::max(d, -children[i].signed_distance(x));
             return d;
         }
     }
@@ -52,13 +56,21 @@ Real Shape::signed_distance(const Vec3& x) const {
 Aabb Shape::bounds() const {
     Aabb box;
     switch (kind) {
-        case Kind::Box: box = {a.cwiseMin(b), a.cwiseMax(b)}; break;
-        case Kind::Sphere: box = {a.array() - radius, a.array() + radius}; break;
-        case Kind::Cylinder: box = {a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius}; break;
+        case Kind::Box:
+            box = {a.cwiseMin(b), a.cwiseMax(b)};
+            break;
+        case Kind::Sphere:
+            box = {a.array() - radius, a.array() + radius};
+            break;
+        case Kind::Cylinder:
+            box = {a.cwiseMin(b).array() - radius, a.cwiseMax(b).array() + radius};
+            break;
         case Kind::Union:
             for (const Shape& c : children) box.extend(c.bounds());
             break;
-        case Kind::Difference: box = children.front().bounds(); break;
+        case Kind::Difference:
+            box = children.front().bounds();
+            break;
     }
     return box;
 }

@@ -16,15 +16,17 @@ struct Aabb {
     void extend(const Vec3& p) { min = min.cwiseMin(p), max = max.cwiseMax(p); }
     void extend(const Aabb& b) { min = min.cwiseMin(b.min), max = max.cwiseMax(b.max); }
     Aabb padded(Real d) const { return {min.array() - d, max.array() + d}; }
-    bool contains(const Vec3& p) const { return (p.array() >= min.array()).all() && (p.array() <= max.array()).all(); }
+    bool contains(const Vec3& p) const {
+        return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+    }
 };
 
 struct Shape {
     enum class Kind { Box, Sphere, Cylinder, Union, Difference };
     Kind kind = Kind::Box;
-    Vec3 a = Vec3::Zero();  ///< box min, sphere centre, cylinder base centre (m)
-    Vec3 b = Vec3::Zero();  ///< box max, cylinder top centre (m)
-    Real radius = 0;        ///< sphere and cylinder radius (m)
+    Vec3 a = Vec3::Zero();        ///< box min, sphere centre, cylinder base centre (m)
+    Vec3 b = Vec3::Zero();        ///< box max, cylinder top centre (m)
+    Real radius = 0;              ///< sphere and cylinder radius (m)
     std::vector<Shape> children;  ///< union members; difference: first minus the rest
 
     /// Signed distance (m), negative inside. Exact for primitives; union/difference use min/max,

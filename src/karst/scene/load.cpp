@@ -16,7 +16,9 @@ namespace {
 
 using json = nlohmann::json;
 
-Vec3 vec3(const json& v) { return {v[0].get<Real>(), v[1].get<Real>(), v[2].get<Real>()}; }
+Vec3 vec3(const json& v) {
+    return {v[0].get<Real>(), v[1].get<Real>(), v[2].get<Real>()};
+}
 
 /// The value of an enum key (validated against the schema's options): every option must map to
 /// a value here, so an option added to the schema and forgotten here fails loudly.
@@ -40,7 +42,8 @@ Shape read_shape(const json& j, const std::string& path) {
     } else if (type == "sphere") {
         s.kind = Shape::Kind::Sphere, s.a = vec3(j["center"]), s.radius = j["radius"];
     } else if (type == "cylinder") {
-        s.kind = Shape::Kind::Cylinder, s.a = vec3(j["base"]), s.b = vec3(j["top"]), s.radius = j["radius"];
+        s.kind = Shape::Kind::Cylinder, s.a = vec3(j["base"]), s.b = vec3(j["top"]),
+        s.radius = j["radius"];
         if ((s.b - s.a).norm() <= 0)
             throw SceneError(path + "/top", "a point different from base", j["top"].dump());
     } else {
@@ -58,7 +61,8 @@ Scene parse_scene(const std::string& text) {
     try {
         doc = json::parse(text);
     } catch (const json::parse_error& e) {
-        throw SceneError("", "valid JSON", fmt::format("a syntax error at byte {}: {}", e.byte, e.what()));
+        throw SceneError("", "valid JSON",
+                         fmt::format("a syntax error at byte {}: {}", e.byte, e.what()));
     }
     validate_scene_document(doc);
 
@@ -70,11 +74,13 @@ Scene parse_scene(const std::string& text) {
         s.domain = Aabb{vec3(doc["domain"]["min"]), vec3(doc["domain"]["max"])};
         for (int d = 0; d < 3; ++d)
             if (!(s.domain->max[d] > s.domain->min[d]))
-                throw SceneError(fmt::format("/domain/max/{}", d), fmt::format("a value above min {}", s.domain->min[d]),
+                throw SceneError(fmt::format("/domain/max/{}", d),
+                                 fmt::format("a value above min {}", s.domain->min[d]),
                                  fmt::format("{}", s.domain->max[d]));
     }
     const json& t = doc["time"];
-    s.time.end = t["end"], s.time.cfl = t["cfl"], s.time.dt_max = t["dt_max"], s.time.dt_min = t["dt_min"];
+    s.time.end = t["end"], s.time.cfl = t["cfl"], s.time.dt_max = t["dt_max"],
+    s.time.dt_min = t["dt_min"];
     if (t.contains("fixed_dt")) s.time.fixed_dt = t["fixed_dt"].get<Real>();
     if (s.time.dt_min > s.time.dt_max)
         throw SceneError("/time/dt_min", fmt::format("a value at most dt_max = {}", s.time.dt_max),
@@ -86,24 +92,29 @@ Scene parse_scene(const std::string& text) {
     s.fluid.surface_tension = f["surface_tension"], s.fluid.adhesion = f["adhesion"];
     s.fluid.wall_friction = f["wall_friction"], s.fluid.sound_speed = f["sound_speed"];
     s.fluid.solute_diffusivity = f["solute_diffusivity"];
-    s.fluid.solver = option<FluidSettings::Solver>(f["solver"], {{"dfsph", FluidSettings::Solver::Dfsph}, {"pcisph", FluidSettings::Solver::Pcisph}});
+    s.fluid.solver = option<FluidSettings::Solver>(
+        f["solver"],
+        {{"dfsph", FluidSettings::Solver::Dfsph}, {"pcisph", FluidSettings::Solver::Pcisph}});
     s.fluid.max_density_error = f["max_density_error"];
     s.fluid.max_divergence_error = f["max_divergence_error"];
     s.fluid.min_iterations = f["min_iterations"], s.fluid.max_iterations = f["max_iterations"];
     if (s.fluid.min_iterations > s.fluid.max_iterations)
-        throw SceneError("/fluid/min_iterations", fmt::format("at most max_iterations = {}", s.fluid.max_iterations),
+        throw SceneError("/fluid/min_iterations",
+                         fmt::format("at most max_iterations = {}", s.fluid.max_iterations),
                          fmt::format("{}", s.fluid.min_iterations));
 
     for (size_t i = 0; i < doc["fluid_blocks"].size(); ++i) {
         const json& b = doc["fluid_blocks"][i];
         const std::string path = fmt::format("/fluid_blocks/{}", i);
-        s.fluid_blocks.push_back({read_shape(b["shape"], path + "/shape"), vec3(b["velocity"]), path, b["concentration"].get<Real>()});
+        s.fluid_blocks.push_back({read_shape(b["shape"], path + "/shape"), vec3(b["velocity"]),
+                                  path, b["concentration"].get<Real>()});
     }
     for (size_t i = 0; i < doc["walls"].size(); ++i) {
         const json& w = doc["walls"][i];
         const std::string path = fmt::format("/walls/{}", i);
         s.walls.push_back({read_shape(w["shape"], path + "/shape"),
-                           option<Wall::Kind>(w["kind"], {{"container", Wall::Kind::Container}, {"obstacle", Wall::Kind::Obstacle}}),
+                           option<Wall::Kind>(w["kind"], {{"container", Wall::Kind::Container},
+                                                          {"obstacle", Wall::Kind::Obstacle}}),
                            w["layers"].get<int>(), path});
     }
     for (size_t i = 0; i < doc["porous_solids"].size(); ++i) {
@@ -113,57 +124,83 @@ Scene parse_scene(const std::string& text) {
         solid.shape = read_shape(j["shape"], solid.path + "/shape");
         const json& m = j["material"];
         PorousMaterial& mat = solid.material;
-        mat.porosity = m["porosity"], mat.permeability = m["permeability"], mat.darcy_viscosity = m["darcy_viscosity"];
+        mat.porosity = m["porosity"], mat.permeability = m["permeability"],
+        mat.darcy_viscosity = m["darcy_viscosity"];
         mat.solid_density = m["solid_density"], mat.youngs_modulus = m["youngs_modulus"];
         mat.poisson_ratio = m["poisson_ratio"], mat.biot_coefficient = m["biot_coefficient"];
         mat.tensile_strength = m["tensile_strength"];
-        mat.capillary_pressure = m["capillary_pressure"], mat.capillary_exponent = m["capillary_exponent"];
-        mat.pore_stiffness = m["pore_stiffness"], mat.saturation_exponent = m["saturation_exponent"];
+        mat.capillary_pressure = m["capillary_pressure"],
+        mat.capillary_exponent = m["capillary_exponent"];
+        mat.pore_stiffness = m["pore_stiffness"],
+        mat.saturation_exponent = m["saturation_exponent"];
         mat.pore_exponent = m["pore_exponent"];
         mat.initial_saturation = m["initial_saturation"];
-        mat.dissolution_porosity = m["dissolution_porosity"], mat.dissolution_saturation = m["dissolution_saturation"];
+        mat.dissolution_porosity = m["dissolution_porosity"],
+        mat.dissolution_saturation = m["dissolution_saturation"];
         mat.absorption_factor = m["absorption_factor"];
         using Layering = PorousMaterial::Layering;
-        mat.layering = option<Layering>(j["layering"]["kind"], {{"bedding", Layering::Bedding}, {"fibre", Layering::Fibre}, {"from_geometry", Layering::FromGeometry}});
-        solid.anchored = j["anchored"], solid.velocity = vec3(j["velocity"]), solid.angular_velocity = vec3(j["angular_velocity"]);
-        mat.layering_normal = vec3(j["layering"]["normal"]), mat.layering_ratio = j["layering"]["ratio"];
+        mat.layering =
+            option<Layering>(j["layering"]["kind"], {{"bedding", Layering::Bedding},
+                                                     {"fibre", Layering::Fibre},
+                                                     {"from_geometry", Layering::FromGeometry}});
+        solid.anchored = j["anchored"], solid.velocity = vec3(j["velocity"]),
+        solid.angular_velocity = vec3(j["angular_velocity"]);
+        mat.layering_normal = vec3(j["layering"]["normal"]),
+        mat.layering_ratio = j["layering"]["ratio"];
         if (mat.layering_normal.norm() < 1e-6)
             throw SceneError(solid.path + "/layering/normal", "a non-zero direction", "[0, 0, 0]");
         for (size_t w = 0; w < j["wet_regions"].size(); ++w)
-            solid.wet_regions.push_back({read_shape(j["wet_regions"][w]["region"], fmt::format("{}/wet_regions/{}/region", solid.path, w)),
-                                         j["wet_regions"][w]["saturation"].get<Real>()});
+            solid.wet_regions.push_back(
+                {read_shape(j["wet_regions"][w]["region"],
+                            fmt::format("{}/wet_regions/{}/region", solid.path, w)),
+                 j["wet_regions"][w]["saturation"].get<Real>()});
         if (mat.biot_coefficient < mat.porosity)  // else the grains would have negative storage
-            throw SceneError(solid.path + "/material/biot_coefficient", fmt::format("a value at least the porosity {}", mat.porosity),
+            throw SceneError(solid.path + "/material/biot_coefficient",
+                             fmt::format("a value at least the porosity {}", mat.porosity),
                              fmt::format("{}", mat.biot_coefficient));
         for (size_t c = 0; c < j["constraints"].size(); ++c) {
             const json& cj = j["constraints"][c];
             Constraint con;
             con.path = fmt::format("{}/constraints/{}", solid.path, c);
-            con.kind = option<Constraint::Kind>(cj["kind"], {{"fixed", Constraint::Kind::Fixed}, {"drained", Constraint::Kind::Drained}, {"traction", Constraint::Kind::Traction}});
+            con.kind =
+                option<Constraint::Kind>(cj["kind"], {{"fixed", Constraint::Kind::Fixed},
+                                                      {"drained", Constraint::Kind::Drained},
+                                                      {"traction", Constraint::Kind::Traction}});
             con.region = read_shape(cj["region"], con.path + "/region");
             const std::string axes = cj["axes"];
-            con.axes = std::uint8_t((axes.find('x') != std::string::npos ? 1 : 0) | (axes.find('y') != std::string::npos ? 2 : 0) |
+            con.axes = std::uint8_t((axes.find('x') != std::string::npos ? 1 : 0) |
+                                    (axes.find('y') != std::string::npos ? 2 : 0) |
                                     (axes.find('z') != std::string::npos ? 4 : 0));
             con.pressure = cj["pressure"], con.traction = vec3(cj["traction"]);
             solid.constraints.push_back(std::move(con));
         }
         s.porous_solids.push_back(std::move(solid));
     }
-    s.paper_eq20 = option<bool>(doc["pore_flow"]["pair_flux"], {{"darcy", false}, {"paper_eq20", true}});
+    s.paper_eq20 =
+        option<bool>(doc["pore_flow"]["pair_flux"], {{"darcy", false}, {"paper_eq20", true}});
     const json& pe = doc["poroelastic"];
-    s.poroelastic.time_step = pe["time_step"], s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
-    s.poroelastic.fixed_strain = option<bool>(pe["splitting"], {{"fixed_stress", false}, {"fixed_strain", true}});
-    s.poroelastic.pressure_from_pore_water = option<bool>(pe["pressure_source"], {{"pore_water", true}, {"biot", false}});
-    s.poroelastic.mfem_polyhedra = option<bool>(pe["shape_functions"], {{"p1", false}, {"mfem_polyhedra", true}});
+    s.poroelastic.time_step = pe["time_step"],
+    s.poroelastic.fluid_bulk_modulus = pe["fluid_bulk_modulus"];
+    s.poroelastic.fixed_strain =
+        option<bool>(pe["splitting"], {{"fixed_stress", false}, {"fixed_strain", true}});
+    s.poroelastic.pressure_from_pore_water =
+        option<bool>(pe["pressure_source"], {{"pore_water", true}, {"biot", false}});
+    s.poroelastic.mfem_polyhedra =
+        option<bool>(pe["shape_functions"], {{"p1", false}, {"mfem_polyhedra", true}});
     using Solver = PoroelasticSettings::LinearSolver;
-    s.poroelastic.linear_solver = option<Solver>(pe["linear_solver"], {{"auto", Solver::Auto}, {"direct", Solver::Direct}, {"amg", Solver::Amg}});
-    s.poroelastic.coupled_fragments = option<bool>(pe["coupled_fragments"], {{"anchored", true}, {"none", false}});
+    s.poroelastic.linear_solver =
+        option<Solver>(pe["linear_solver"],
+                       {{"auto", Solver::Auto}, {"direct", Solver::Direct}, {"amg", Solver::Amg}});
+    s.poroelastic.coupled_fragments =
+        option<bool>(pe["coupled_fragments"], {{"anchored", true}, {"none", false}});
     s.poroelastic.max_iterations = pe["max_iterations"], s.poroelastic.tolerance = pe["tolerance"];
-    s.poroelastic.anderson = option<bool>(pe["acceleration"], {{"anderson", true}, {"none", false}});
+    s.poroelastic.anderson =
+        option<bool>(pe["acceleration"], {{"anderson", true}, {"none", false}});
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
     s.poroelastic.weighted_alpha = pe["weighted_alpha"];
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];
-    s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"], s.output.ply = doc["output"]["ply"];
+    s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"],
+    s.output.ply = doc["output"]["ply"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];
     return s;

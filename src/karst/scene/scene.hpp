@@ -14,26 +14,26 @@
 namespace karst {
 
 struct TimeSettings {
-    Real end{};                ///< s
-    Real cfl{};                ///< lambda_v of M11
-    Real dt_max{};            ///< s
-    Real dt_min{};            ///< s
+    Real end{};                    ///< s
+    Real cfl{};                    ///< lambda_v of M11
+    Real dt_max{};                 ///< s
+    Real dt_min{};                 ///< s
     std::optional<Real> fixed_dt;  ///< s; absent: adaptive
 };
 
 struct FluidSettings {
-    Real rest_density{};       ///< rho0, kg/m^3
-    Real viscosity{};          ///< nu, m^2/s
+    Real rest_density{};          ///< rho0, kg/m^3
+    Real viscosity{};             ///< nu, m^2/s
     Real artificial_viscosity{};  ///< alpha_v (Becker & Teschner 2007)
     Real surface_tension{};       ///< gamma_st
     Real adhesion{};              ///< beta_adh
     Real wall_friction{};         ///< sigma_f
-    Real sound_speed{};          ///< c_s, m/s
-    Real solute_diffusivity{}; ///< D of M18, m^2/s
+    Real sound_speed{};           ///< c_s, m/s
+    Real solute_diffusivity{};    ///< D of M18, m^2/s
     enum class Solver { Dfsph, Pcisph };
-    Solver solver{};  ///< pressure solver
-    Real max_density_error{};  ///< eta_rho
-    Real max_divergence_error{};   ///< DFSPH divergence solve: largest dt Drho/Dt / rho0
+    Solver solver{};              ///< pressure solver
+    Real max_density_error{};     ///< eta_rho
+    Real max_divergence_error{};  ///< DFSPH divergence solve: largest dt Drho/Dt / rho0
     int min_iterations{};
     int max_iterations{};
 };
@@ -42,7 +42,7 @@ struct FluidBlock {
     Shape shape;
     Vec3 velocity = Vec3::Zero();  ///< m/s
     std::string path;              ///< JSON pointer, for error messages
-    Real concentration{};        ///< initial C = m_sol / m
+    Real concentration{};          ///< initial C = m_sol / m
 };
 
 struct Wall {
@@ -54,27 +54,27 @@ struct Wall {
 };
 
 struct PorousMaterial {
-    Real porosity{};            ///< phi0
-    Real permeability{};       ///< k0, m^2
-    Real darcy_viscosity{};     ///< eta, Pa s
-    Real solid_density{};      ///< rho_s, kg/m^3
-    Real youngs_modulus{};      ///< E (drained), Pa
+    Real porosity{};         ///< phi0
+    Real permeability{};     ///< k0, m^2
+    Real darcy_viscosity{};  ///< eta, Pa s
+    Real solid_density{};    ///< rho_s, kg/m^3
+    Real youngs_modulus{};   ///< E (drained), Pa
     Real poisson_ratio{};
-    Real biot_coefficient{};    ///< B
-    Real tensile_strength{};    ///< sigma_t, Pa
+    Real biot_coefficient{};     ///< B
+    Real tensile_strength{};     ///< sigma_t, Pa
     Real capillary_pressure{};   ///< k^c, Pa
-    Real capillary_exponent{};    ///< alpha
-    Real pore_stiffness{};      ///< k^p, Pa
-    Real pore_exponent{};           ///< gamma of M5
-    Real saturation_exponent{};     ///< beta
+    Real capillary_exponent{};   ///< alpha
+    Real pore_stiffness{};       ///< k^p, Pa
+    Real pore_exponent{};        ///< gamma of M5
+    Real saturation_exponent{};  ///< beta
     Real initial_saturation{};
     enum class Layering { Bedding, Fibre, FromGeometry };
     Layering layering{};
-    Vec3 layering_normal = Vec3::Zero();    ///< bedding normal, or fibre tangent
-    Real layering_ratio{};          ///< k along / k across the layers (fibres)
-    Real dissolution_porosity{};  ///< phi_diss (method.md §4.8)
-    Real dissolution_saturation{};  ///< S_diss
-    Real absorption_factor{};       ///< chi_abs of M15
+    Vec3 layering_normal = Vec3::Zero();  ///< bedding normal, or fibre tangent
+    Real layering_ratio{};                ///< k along / k across the layers (fibres)
+    Real dissolution_porosity{};          ///< phi_diss (method.md §4.8)
+    Real dissolution_saturation{};        ///< S_diss
+    Real absorption_factor{};             ///< chi_abs of M15
 };
 
 struct WetRegion {
@@ -87,17 +87,17 @@ struct Constraint {
     enum class Kind { Fixed, Drained, Traction };
     Kind kind{};
     Shape region;
-    std::uint8_t axes{};                ///< Fixed: bits x = 1, y = 2, z = 4
-    Real pressure{};                    ///< Drained, Pa
-    Vec3 traction = Vec3::Zero();         ///< Traction, Pa
+    std::uint8_t axes{};           ///< Fixed: bits x = 1, y = 2, z = 4
+    Real pressure{};               ///< Drained, Pa
+    Vec3 traction = Vec3::Zero();  ///< Traction, Pa
     std::string path;
 };
 
 struct PorousSolid {
     Shape shape;
-    bool anchored{};                     ///< else a free rigid fragment (method.md §4.5)
-    Vec3 velocity = Vec3::Zero();             ///< initial, m/s
-    Vec3 angular_velocity = Vec3::Zero();     ///< initial, rad/s
+    bool anchored{};                       ///< else a free rigid fragment (method.md §4.5)
+    Vec3 velocity = Vec3::Zero();          ///< initial, m/s
+    Vec3 angular_velocity = Vec3::Zero();  ///< initial, rad/s
     PorousMaterial material;
     std::vector<Constraint> constraints;
     std::vector<WetRegion> wet_regions;
@@ -105,20 +105,20 @@ struct PorousSolid {
 };
 
 struct PoroelasticSettings {
-    Real time_step{};       ///< dt_B, s
-    Real fluid_bulk_modulus{};   ///< K_f, Pa
-    bool fixed_strain{};       ///< the paper's splitting instead of fixed-stress
+    Real time_step{};                 ///< dt_B, s
+    Real fluid_bulk_modulus{};        ///< K_f, Pa
+    bool fixed_strain{};              ///< the paper's splitting instead of fixed-stress
     bool pressure_from_pore_water{};  ///< seed p^n from M5 each call (else carry the Biot p)
-    bool mfem_polyhedra{};     ///< M21 shape functions instead of P1
+    bool mfem_polyhedra{};            ///< M21 shape functions instead of P1
     enum class LinearSolver { Auto, Direct, Amg };
-    LinearSolver linear_solver{};    ///< LinearSolver in pfem/biot.hpp says what each does
-    bool coupled_fragments{};   ///< Biot on anchored fragments in coupled scenes
+    LinearSolver linear_solver{};  ///< LinearSolver in pfem/biot.hpp says what each does
+    bool coupled_fragments{};      ///< Biot on anchored fragments in coupled scenes
     int max_iterations{};
-    bool anderson{};            ///< Anderson-accelerated fixed-stress iterations
+    bool anderson{};  ///< Anderson-accelerated fixed-stress iterations
     Real tolerance{};
     bool permeability_feedback{};  ///< §5.4 after every call
-    Real alpha{};               ///< M19
-    Real join_delta{};           ///< M20
+    Real alpha{};                  ///< M19
+    Real join_delta{};             ///< M20
     bool weighted_alpha{};
 };
 
@@ -130,8 +130,8 @@ struct OutputSettings {
 
 struct Scene {
     std::string name;
-    Real particle_spacing{};  ///< dx, m
-    Vec3 gravity = Vec3::Zero();     ///< m/s^2
+    Real particle_spacing{};      ///< dx, m
+    Vec3 gravity = Vec3::Zero();  ///< m/s^2
     std::optional<Aabb> domain;
     TimeSettings time;
     FluidSettings fluid;
@@ -139,7 +139,7 @@ struct Scene {
     std::vector<Wall> walls;
     std::vector<PorousSolid> porous_solids;
     PoroelasticSettings poroelastic;
-    bool paper_eq20{};       ///< /pore_flow/pair_flux: the paper's Eq. 20 instead of M15
+    bool paper_eq20{};  ///< /pore_flow/pair_flux: the paper's Eq. 20 instead of M15
     OutputSettings output;
     Real max_speed{};  ///< watchdog, m/s
     int sort_interval{};

@@ -11,9 +11,15 @@ namespace {
 constexpr double inf = std::numeric_limits<double>::infinity();
 using json = nlohmann::json;
 
-Range positive(double hi = inf) { return {0.0, hi, true, false}; }
-Range closed(double lo, double hi) { return {lo, hi, false, false}; }
-Range any() { return {}; }
+Range positive(double hi = inf) {
+    return {0.0, hi, true, false};
+}
+Range closed(double lo, double hi) {
+    return {lo, hi, false, false};
+}
+Range any() {
+    return {};
+}
 
 KeySpec key(std::string pointer, ValueType type, std::string unit, Range range,
             std::optional<json> value, std::string doc, std::vector<std::string> options = {}) {
@@ -22,25 +28,26 @@ KeySpec key(std::string pointer, ValueType type, std::string unit, Range range,
 }
 KeySpec required(std::string pointer, ValueType type, std::string unit, Range range,
                  std::string doc, std::vector<std::string> options = {}) {
-    return KeySpec{std::move(pointer), type, std::move(unit), range, std::nullopt,
-                   true, std::move(doc), std::move(options)};
+    return KeySpec{std::move(pointer), type, std::move(unit), range,
+                   std::nullopt,       true, std::move(doc),  std::move(options)};
 }
 KeySpec optional(std::string pointer, ValueType type, std::string unit, Range range,
                  std::string doc) {
-    return KeySpec{std::move(pointer), type, std::move(unit), range, std::nullopt, false,
-                   std::move(doc), {}};
+    return KeySpec{std::move(pointer), type,  std::move(unit), range,
+                   std::nullopt,       false, std::move(doc),  {}};
 }
 
 std::vector<KeySpec> make_schema() {
     using T = ValueType;
     const json zero3 = json::array({0.0, 0.0, 0.0});
     return {
-        required("/name", T::String, "", any(), "Scene name; output goes to out/<name>/ by default."),
+        required("/name", T::String, "", any(),
+                 "Scene name; output goes to out/<name>/ by default."),
         required("/particle_spacing", T::Number, "m", positive(10.0),
                  "Particle spacing dx. The SPH support radius is h = 2 dx (method.md §1)."),
         key("/gravity", T::Vec3, "m/s^2", closed(-1000, 1000), json::array({0.0, 0.0, -9.81}),
             "Gravitational acceleration; z is up."),
-        optional("/domain", T::Object, "",  any(),
+        optional("/domain", T::Object, "", any(),
                  "Simulation box; particles leaving it are removed and counted. Absent: the bounds "
                  "of all geometry padded by 4 h on every side."),
         required("/domain/min", T::Vec3, "m", any(), "Lower corner of the domain."),
@@ -62,10 +69,14 @@ std::vector<KeySpec> make_schema() {
         key("/fluid/viscosity", T::Number, "m^2/s", closed(0, 1.0), 1e-6,
             "Kinematic viscosity nu (method.md §4.2)."),
         key("/fluid/artificial_viscosity", T::Number, "", closed(0, 1), 0.01,
-            "alpha_v of the Becker-Teschner artificial viscosity (method.md §4.2), acting only between "
-            "approaching particles; 0 disables it. Water at scene resolution has almost no physical damping, and "
-            "without some a resting tank starts to slosh and spray within a second (0.4 x 0.4 x 0.2 m, dx = 0.02: "
-            "6 m/s after 0.6 s). 0.01 keeps it bounded (RMS 0.03 m/s) and the Martin-Moyce front within 10 %; "
+            "alpha_v of the Becker-Teschner artificial viscosity (method.md §4.2), acting only "
+            "between "
+            "approaching particles; 0 disables it. Water at scene resolution has almost no "
+            "physical damping, and "
+            "without some a resting tank starts to slosh and spray within a second (0.4 x 0.4 x "
+            "0.2 m, dx = 0.02: "
+            "6 m/s after 0.6 s). 0.01 keeps it bounded (RMS 0.03 m/s) and the Martin-Moyce front "
+            "within 10 %; "
             "0.02 lets it settle (RMS 0.016 m/s after 1 s)."),
         key("/fluid/surface_tension", T::Number, "", closed(0, 100), 0.0,
             "Akinci 2013 surface-tension coefficient gamma_st (M9); 0 disables it."),
@@ -74,24 +85,32 @@ std::vector<KeySpec> make_schema() {
         key("/fluid/wall_friction", T::Number, "", closed(0, 10), 0.0,
             "Akinci 2012 fluid-wall friction coefficient sigma_f; 0 gives free slip."),
         key("/fluid/sound_speed", T::Number, "m/s", positive(1e4), 20.0,
-            "Numerical sound speed c_s used by wall friction and artificial viscosity (about 10x the expected speed)."),
+            "Numerical sound speed c_s used by wall friction and artificial viscosity (about 10x "
+            "the expected speed)."),
         key("/fluid/solute_diffusivity", T::Number, "m^2/s", closed(0, 1), 1e-4,
-            "Diffusivity D of the solute among fluid particles (M18; scene-scaled, method.md §8.2)."),
+            "Diffusivity D of the solute among fluid particles (M18; scene-scaled, method.md "
+            "§8.2)."),
         key("/fluid/solver", T::Enum, "", any(), "dfsph",
-            "Pressure solver. dfsph: divergence-free SPH (Bender & Koschier 2017), a velocity-level solve "
-            "that keeps dense fluid from compressing further, then the constant-density solve, both "
+            "Pressure solver. dfsph: divergence-free SPH (Bender & Koschier 2017), a "
+            "velocity-level solve "
+            "that keeps dense fluid from compressing further, then the constant-density solve, "
+            "both "
             "with the Akinci boundary of walls and porous particles; pcisph: the paper's "
-            "predictive-corrective solver (method.md §4.3), kept for comparison: it can gain energy in "
+            "predictive-corrective solver (method.md §4.3), kept for comparison: it can gain "
+            "energy in "
             "impacts.",
             {"dfsph", "pcisph"}),
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
-            "The pressure solve stops when the largest predicted compression is below this fraction of "
+            "The pressure solve stops when the largest predicted compression is below this "
+            "fraction of "
             "rho0."),
         key("/fluid/max_divergence_error", T::Number, "", closed(1e-6, 0.1), 0.01,
-            "DFSPH's divergence solve stops when no particle at or above rho0 would compress by more "
+            "DFSPH's divergence solve stops when no particle at or above rho0 would compress by "
+            "more "
             "than this fraction of rho0 over the step."),
         key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
-            "PCISPH minimum predictor-corrector iterations (DFSPH, warm-started, stops as soon as it "
+            "PCISPH minimum predictor-corrector iterations (DFSPH, warm-started, stops as soon as "
+            "it "
             "meets the tolerance)."),
         key("/fluid/max_iterations", T::Integer, "", closed(1, 1000), 50,
             "Maximum iterations of each pressure solve."),
@@ -112,30 +131,39 @@ std::vector<KeySpec> make_schema() {
             "and particles fill a skin around it.",
             {"obstacle", "container"}),
         key("/walls/[]/layers", T::Integer, "", closed(1, 4), 2,
-            "Thickness of the particle skin, in particle layers. One layer lets fast particles slip through between steps; two is the safe default."),
+            "Thickness of the particle skin, in particle layers. One layer lets fast particles "
+            "slip through between steps; two is the safe default."),
 
         key("/porous_solids", T::ObjectArray, "", any(), json::array(),
-            "Porous solids (method.md §2, §4.5-4.8): particles on the scene lattice. With fluid blocks, or when a "
-            "solid is free, each solid is a rigid fragment coupled two-way with the fluid (Akinci boundary), "
-            "absorbing, carrying and releasing water and dissolving into muddy fluid. Without fluid blocks and "
-            "with every solid anchored, the scene is poroelastic-only: the solids are meshed into tetrahedra "
+            "Porous solids (method.md §2, §4.5-4.8): particles on the scene lattice. With fluid "
+            "blocks, or when a "
+            "solid is free, each solid is a rigid fragment coupled two-way with the fluid (Akinci "
+            "boundary), "
+            "absorbing, carrying and releasing water and dissolving into muddy fluid. Without "
+            "fluid blocks and "
+            "with every solid anchored, the scene is poroelastic-only: the solids are meshed into "
+            "tetrahedra "
             "(PFEM) and the Biot solver runs by itself with /poroelastic/time_step."),
         required("/porous_solids/[]/shape", T::Shape, "", any(), "Geometry of the solid."),
         key("/porous_solids/[]/anchored", T::Bool, "", any(), true,
-            "true: the solid stays put (a rock on the ground); false: a free rigid body (method.md §4.5) "
+            "true: the solid stays put (a rock on the ground); false: a free rigid body (method.md "
+            "§4.5) "
             "moved by gravity, the fluid and contact with walls and other solids."),
-        key("/porous_solids/[]/velocity", T::Vec3, "m/s", closed(-1e3, 1e3), zero3, "Initial velocity of a free solid."),
+        key("/porous_solids/[]/velocity", T::Vec3, "m/s", closed(-1e3, 1e3), zero3,
+            "Initial velocity of a free solid."),
         key("/porous_solids/[]/angular_velocity", T::Vec3, "rad/s", closed(-1e4, 1e4), zero3,
             "Initial angular velocity of a free solid about its centre of mass."),
-        key("/porous_solids/[]/material", T::Object, "", any(), json::object(), "Material of the solid."),
+        key("/porous_solids/[]/material", T::Object, "", any(), json::object(),
+            "Material of the solid."),
         key("/porous_solids/[]/material/porosity", T::Number, "", closed(0, 0.95), 0.3,
-            "Porosity phi0. Below 1e-4 the solid is impermeable (M3): it takes no water, e.g. a floating box."),
+            "Porosity phi0. Below 1e-4 the solid is impermeable (M3): it takes no water, e.g. a "
+            "floating box."),
         key("/porous_solids/[]/material/permeability", T::Number, "m^2", closed(1e-25, 1e-3), 2e-8,
             "Intrinsic permeability k0 (scene-scaled default, method.md §8.2)."),
         key("/porous_solids/[]/material/darcy_viscosity", T::Number, "Pa s", closed(1e-6, 1e6), 0.1,
             "Dynamic viscosity eta of the pore water in Darcy's law."),
-        key("/porous_solids/[]/material/solid_density", T::Number, "kg/m^3", closed(10, 30000), 2650.0,
-            "Density of the grains rho_s."),
+        key("/porous_solids/[]/material/solid_density", T::Number, "kg/m^3", closed(10, 30000),
+            2650.0, "Density of the grains rho_s."),
         key("/porous_solids/[]/material/youngs_modulus", T::Number, "Pa", closed(1, 1e13), 1e6,
             "Drained Young's modulus E of the skeleton (scene-scaled default)."),
         key("/porous_solids/[]/material/poisson_ratio", T::Number, "", closed(0, 0.49), 0.25,
@@ -144,8 +172,8 @@ std::vector<KeySpec> make_schema() {
             "Biot coefficient B = 1 - K_dr/K_s; it fixes the grain modulus K_s."),
         key("/porous_solids/[]/material/tensile_strength", T::Number, "Pa", positive(1e12), 1e5,
             "Tensile strength sigma_t of the Rankine test (M25); output marks crack candidates."),
-        key("/porous_solids/[]/material/capillary_pressure", T::Number, "Pa", closed(0, 1e8), 2000.0,
-            "Capillary scale k^c of M4: the suction of dry material."),
+        key("/porous_solids/[]/material/capillary_pressure", T::Number, "Pa", closed(0, 1e8),
+            2000.0, "Capillary scale k^c of M4: the suction of dry material."),
         key("/porous_solids/[]/material/capillary_exponent", T::Number, "", closed(0.01, 1), 0.5,
             "Exponent alpha of M4, P^c = k^c (1 - S)^alpha."),
         key("/porous_solids/[]/material/pore_stiffness", T::Number, "Pa", closed(1, 1e10), 1.4e4,
@@ -158,61 +186,81 @@ std::vector<KeySpec> make_schema() {
             "Saturation S at t = 0 outside the wet regions."),
         key("/porous_solids/[]/material/dissolution_porosity", T::Number, "", closed(0, 1), 0.6,
             "phi_diss of method.md §4.8: particles at least this porous dissolve once saturated."),
-        key("/porous_solids/[]/material/dissolution_saturation", T::Number, "", closed(0.5, 2), 0.98,
-            "S_diss of method.md §4.8."),
+        key("/porous_solids/[]/material/dissolution_saturation", T::Number, "", closed(0.5, 2),
+            0.98, "S_diss of method.md §4.8."),
         key("/porous_solids/[]/material/absorption_factor", T::Number, "", closed(0, 1e3), 1.0,
-            "chi_abs of M15: scales the permeability of fluid-porous pairs (how fast the surface absorbs)."),
+            "chi_abs of M15: scales the permeability of fluid-porous pairs (how fast the surface "
+            "absorbs)."),
         key("/porous_solids/[]/layering", T::Object, "", any(), json::object(),
-            "Layering of the permeability (M12): ratio along / across bedding planes or a fibre axis."),
+            "Layering of the permeability (M12): ratio along / across bedding planes or a fibre "
+            "axis."),
         key("/porous_solids/[]/layering/kind", T::Enum, "", any(), "bedding",
-            "bedding: planes with the given normal; fibre: fibres along the given axis (normal is read as the "
-            "fibre tangent, K0 = k_perp I + (k_par - k_perp) t t^T); from_geometry: bedding planes whose normal is, "
+            "bedding: planes with the given normal; fibre: fibres along the given axis (normal is "
+            "read as the "
+            "fibre tangent, K0 = k_perp I + (k_par - k_perp) t t^T); from_geometry: bedding planes "
+            "whose normal is, "
             "per particle, the direction of least spread of its neighbourhood (weighted PCA, M28).",
             {"bedding", "fibre", "from_geometry"}),
-        key("/porous_solids/[]/layering/normal", T::Vec3, "", closed(-1, 1), json::array({0.0, 0.0, 1.0}),
+        key("/porous_solids/[]/layering/normal", T::Vec3, "", closed(-1, 1),
+            json::array({0.0, 0.0, 1.0}),
             "Bedding-plane normal (or fibre tangent) in the solid's frame."),
         key("/porous_solids/[]/layering/ratio", T::Number, "", closed(0.01, 100), 1.0,
             "k along the layers (fibres) / k across them (1: isotropic); det K stays k0^3."),
         key("/porous_solids/[]/wet_regions", T::ObjectArray, "", any(), json::array(),
             "Regions of the solid that start wet."),
-        required("/porous_solids/[]/wet_regions/[]/region", T::Shape, "", any(), "Where the solid starts wet."),
-        key("/porous_solids/[]/wet_regions/[]/saturation", T::Number, "", closed(0, 1.2), 1.0, "Saturation there."),
+        required("/porous_solids/[]/wet_regions/[]/region", T::Shape, "", any(),
+                 "Where the solid starts wet."),
+        key("/porous_solids/[]/wet_regions/[]/saturation", T::Number, "", closed(0, 1.2), 1.0,
+            "Saturation there."),
         key("/porous_solids/[]/constraints", T::ObjectArray, "", any(), json::array(),
             "Boundary conditions of the Biot problem on regions of the solid. A node belongs to a "
-            "region when it lies inside it or within 3/4 of a spacing of it (the outer particles sit half a spacing inside the geometry). Unconstrained: free "
+            "region when it lies inside it or within 3/4 of a spacing of it (the outer particles "
+            "sit half a spacing inside the geometry). Unconstrained: free "
             "body (rigid modes held by a weak spring), no flux."),
         required("/porous_solids/[]/constraints/[]/kind", T::Enum, "", any(),
                  "fixed: displacement 0 on the given axes; drained: pore pressure prescribed; "
                  "traction: a uniform traction on the surface facets inside the region.",
                  {"fixed", "drained", "traction"}),
-        required("/porous_solids/[]/constraints/[]/region", T::Shape, "", any(), "Where the condition holds."),
+        required("/porous_solids/[]/constraints/[]/region", T::Shape, "", any(),
+                 "Where the condition holds."),
         key("/porous_solids/[]/constraints/[]/axes", T::Enum, "", any(), "xyz",
-            "fixed only: the displacement components held at 0.", {"xyz", "x", "y", "z", "xy", "xz", "yz"}),
+            "fixed only: the displacement components held at 0.",
+            {"xyz", "x", "y", "z", "xy", "xz", "yz"}),
         key("/porous_solids/[]/constraints/[]/pressure", T::Number, "Pa", closed(-1e12, 1e12), 0.0,
             "drained only: the prescribed pore pressure."),
         key("/porous_solids/[]/constraints/[]/traction", T::Vec3, "Pa", closed(-1e12, 1e12), zero3,
             "traction only: force per area on the surface (e.g. [0, 0, -1e4] presses down)."),
 
-        key("/pore_flow", T::Object, "", any(), json::object(), "Transport of pore water between porous particles (method.md §4.7)."),
+        key("/pore_flow", T::Object, "", any(), json::object(),
+            "Transport of pore water between porous particles (method.md §4.7)."),
         key("/pore_flow/pair_flux", T::Enum, "", any(), "darcy",
-            "darcy: the conservative Darcy pair flux M15, driven by pore pressure, capillarity and gravity; "
-            "paper_eq20: the paper's Eq. 20 in its conservative form (method.md §9 item 7), which diffuses the "
-            "absorbed mass along the pore velocity and ignores gravity and capillarity as drivers, for comparison.",
+            "darcy: the conservative Darcy pair flux M15, driven by pore pressure, capillarity and "
+            "gravity; "
+            "paper_eq20: the paper's Eq. 20 in its conservative form (method.md §9 item 7), which "
+            "diffuses the "
+            "absorbed mass along the pore velocity and ignores gravity and capillarity as drivers, "
+            "for comparison.",
             {"darcy", "paper_eq20"}),
-        key("/poroelastic", T::Object, "", any(), json::object(), "PFEM mesh and Biot solver (method.md §5)."),
+        key("/poroelastic", T::Object, "", any(), json::object(),
+            "PFEM mesh and Biot solver (method.md §5)."),
         key("/poroelastic/time_step", T::Number, "s", positive(1e6), 1.0 / 30,
             "Biot step dt_B (one call per step; method.md §8.2: one per frame)."),
         key("/poroelastic/coupled_fragments", T::Enum, "", any(), "anchored",
-            "In a scene with fluid or free solids: anchored: every anchored fragment of a permeable solid is "
-            "meshed and gets a Biot call every time_step, loaded by the fluid's forces, with its pore pressure "
-            "from the pore water, feeding porosity, bulk volume and permeability back (method.md §5); none: "
-            "fragments stay rigid (faster; no stress, no mesh frames). Free fragments are not solved.",
+            "In a scene with fluid or free solids: anchored: every anchored fragment of a "
+            "permeable solid is "
+            "meshed and gets a Biot call every time_step, loaded by the fluid's forces, with its "
+            "pore pressure "
+            "from the pore water, feeding porosity, bulk volume and permeability back (method.md "
+            "§5); none: "
+            "fragments stay rigid (faster; no stress, no mesh frames). Free fragments are not "
+            "solved.",
             {"anchored", "none"}),
         key("/poroelastic/fluid_bulk_modulus", T::Number, "Pa", closed(1, 1e12), 1e5,
             "Pore-water bulk modulus K_f in the Biot storage 1/M = phi/K_f + (B - phi)/K_s. The "
             "default is the SPH pore stiffness gamma k^p (method.md §8.2); water is 2.2e9."),
         key("/poroelastic/pressure_source", T::Enum, "", any(), "pore_water",
-            "pore_water: the pore water moves by Darcy flow among the particles (M15) and seeds the "
+            "pore_water: the pore water moves by Darcy flow among the particles (M15) and seeds "
+            "the "
             "Biot pressure at every call from M5 (method.md §5.3); biot: the Biot pressure is "
             "carried from call to call (linear poroelasticity, e.g. Terzaghi's test).",
             {"pore_water", "biot"}),
@@ -226,16 +274,20 @@ std::vector<KeySpec> make_schema() {
             "cantilever: 0.4 % off Timoshenko against 5 % with p1 at the same nodes).",
             {"p1", "mfem_polyhedra"}),
         key("/poroelastic/linear_solver", T::Enum, "", any(), "auto",
-            "direct: CHOLMOD for both systems (a slow factorisation per mesh, then fast solves); amg: "
-            "conjugate gradients with hypre's BoomerAMG for both (a fast set-up, slower solves), for "
-            "meshes rebuilt at nearly every call or too big for a factor's memory; auto: CHOLMOD for "
+            "direct: CHOLMOD for both systems (a slow factorisation per mesh, then fast solves); "
+            "amg: "
+            "conjugate gradients with hypre's BoomerAMG for both (a fast set-up, slower solves), "
+            "for "
+            "meshes rebuilt at nearly every call or too big for a factor's memory; auto: CHOLMOD "
+            "for "
             "the elasticity and, from 30,000 pressure unknowns, AMG for the flow, which is set up "
             "again whenever dt or the permeability changes.",
             {"auto", "direct", "amg"}),
         key("/poroelastic/max_iterations", T::Integer, "", closed(1, 1000), 5, "k_max of M22."),
         key("/poroelastic/acceleration", T::Enum, "", any(), "anderson",
             "anderson: the fixed-stress pressure iterates are mixed over the last three (Anderson "
-            "acceleration: fewer iterations per call, most where the coupling is strong); none: the "
+            "acceleration: fewer iterations per call, most where the coupling is strong); none: "
+            "the "
             "plain M22 iteration. The fixed-strain order is never accelerated.",
             {"anderson", "none"}),
         key("/poroelastic/tolerance", T::Number, "", closed(1e-14, 1), 1e-3,
@@ -243,15 +295,19 @@ std::vector<KeySpec> make_schema() {
         key("/poroelastic/permeability_feedback", T::Bool, "", any(), true,
             "Update porosity (M23) and permeability (M24) from the strain and pressure after every "
             "Biot call; false keeps k = k0, as linear poroelasticity benchmarks assume."),
-        key("/poroelastic/alpha", T::Number, "", closed(0.6, 10), 1.25, "Alpha-shape factor (M19)."),
-        key("/poroelastic/join_delta", T::Number, "", closed(0, 1), 0.1, "EDT joining factor delta (M20)."),
+        key("/poroelastic/alpha", T::Number, "", closed(0.6, 10), 1.25,
+            "Alpha-shape factor (M19)."),
+        key("/poroelastic/join_delta", T::Number, "", closed(0, 1), 0.1,
+            "EDT joining factor delta (M20)."),
         key("/poroelastic/weighted_alpha", T::Bool, "", any(), false,
             "Use the weighted alpha shape (regular triangulation) instead of the plain one."),
 
         key("/output", T::Object, "", any(), json::object(), "What is written, and how often."),
-        key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0, "Frames per simulated second."),
+        key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0,
+            "Frames per simulated second."),
         key("/output/vtp", T::Bool, "", any(), true, "Write fluid_NNNN.vtp frames and run.pvd."),
-        key("/output/ply", T::Bool, "", any(), true, "Write binary PLY point frames fluid_NNNN.ply."),
+        key("/output/ply", T::Bool, "", any(), true,
+            "Write binary PLY point frames fluid_NNNN.ply."),
 
         key("/watchdog", T::Object, "", any(), json::object(), "Run-time sanity limits."),
         key("/watchdog/max_speed", T::Number, "m/s", positive(1e6), 100.0,
@@ -303,21 +359,30 @@ const std::vector<KeySpec>& scene_schema() {
 
 std::string describe_type(const KeySpec& spec) {
     switch (spec.type) {
-        case ValueType::String: return "string";
-        case ValueType::Number: return "number";
-        case ValueType::Integer: return "integer";
-        case ValueType::Bool: return "boolean";
-        case ValueType::Vec3: return "array of 3 numbers";
+        case ValueType::String:
+            return "string";
+        case ValueType::Number:
+            return "number";
+        case ValueType::Integer:
+            return "integer";
+        case ValueType::Bool:
+            return "boolean";
+        case ValueType::Vec3:
+            return "array of 3 numbers";
         case ValueType::Enum: {
             std::string s = "one of";
             for (size_t i = 0; i < spec.options.size(); ++i)
                 s += fmt::format("{} \"{}\"", i ? "," : "", spec.options[i]);
             return s;
         }
-        case ValueType::Object: return "object";
-        case ValueType::ObjectArray: return "array of objects";
-        case ValueType::Shape: return "shape object";
-        case ValueType::ShapeArray: return "non-empty array of shape objects";
+        case ValueType::Object:
+            return "object";
+        case ValueType::ObjectArray:
+            return "array of objects";
+        case ValueType::Shape:
+            return "shape object";
+        case ValueType::ShapeArray:
+            return "non-empty array of shape objects";
     }
     return "?";
 }
@@ -326,9 +391,11 @@ std::string scene_schema_markdown() {
     std::string md =
         "# Scene format\n\n"
         "<!-- Generated by `karst schema` from src/karst/scene/schema.cpp; do not edit. -->\n\n"
-        "A scene is one JSON object. Units are SI. Unknown keys, wrong types and out-of-range values\n"
+        "A scene is one JSON object. Units are SI. Unknown keys, wrong types and out-of-range "
+        "values\n"
         "are refused before simulating, with the JSON path, what was expected and what was found\n"
-        "(exit code 2). `[]` stands for any array index. Geometry objects (`shape`) are described by\n"
+        "(exit code 2). `[]` stands for any array index. Geometry objects (`shape`) are described "
+        "by\n"
         "the `shape` rows: `shape/type` picks the kind and `shape:<type>/...` lists its keys;\n"
         "`union` and `difference` nest further shapes. All particles lie on one lattice\n"
         "`(i + 1/2) dx`, so fluid and walls fit together without gaps.\n\n"
@@ -336,8 +403,8 @@ std::string scene_schema_markdown() {
         "|---|---|---|---|---|---|\n";
     for (const KeySpec& s : scene_schema()) {
         std::string def = s.value ? s.value->dump() : (s.required ? "required" : "optional");
-        md += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", s.pointer, describe_type(s), s.unit,
-                          s.range.describe(), def, s.doc);
+        md += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", s.pointer, describe_type(s),
+                          s.unit, s.range.describe(), def, s.doc);
     }
     return md;
 }

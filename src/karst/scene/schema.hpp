@@ -36,10 +36,11 @@ struct Range {
 struct KeySpec {
     std::string pointer;  ///< "/fluid/viscosity"; "[]" stands for any array index; "shape:box/min"
     ValueType type;
-    std::string unit;                     ///< SI unit, "" for dimensionless
-    Range range;                          ///< numbers only
-    std::optional<nlohmann::json> value;  ///< default; none with `required` means the key must be given
-    bool required = false;                ///< true: no default, must be present; false and no value: optional
+    std::string unit;  ///< SI unit, "" for dimensionless
+    Range range;       ///< numbers only
+    std::optional<nlohmann::json>
+        value;              ///< default; none with `required` means the key must be given
+    bool required = false;  ///< true: no default, must be present; false and no value: optional
     std::string doc;
     std::vector<std::string> options;  ///< Enum only
 };

@@ -27,19 +27,27 @@ const std::map<std::string, std::vector<const KeySpec*>>& children_by_parent() {
     return table;
 }
 
-std::string leaf_name(const std::string& pointer) { return pointer.substr(pointer.rfind('/') + 1); }
+std::string leaf_name(const std::string& pointer) {
+    return pointer.substr(pointer.rfind('/') + 1);
+}
 
 /// A short description of a JSON value for error messages.
 std::string describe_value(const json& v) {
     std::string d = v.dump();
     if (d.size() > 60) d = d.substr(0, 57) + "...";
     switch (v.type()) {
-        case json::value_t::string: return "string " + d;
-        case json::value_t::boolean: return "boolean " + d;
-        case json::value_t::array: return "array " + d;
-        case json::value_t::object: return "object " + d;
-        case json::value_t::null: return "null";
-        default: return d;
+        case json::value_t::string:
+            return "string " + d;
+        case json::value_t::boolean:
+            return "boolean " + d;
+        case json::value_t::array:
+            return "array " + d;
+        case json::value_t::object:
+            return "object " + d;
+        case json::value_t::null:
+            return "null";
+        default:
+            return d;
     }
 }
 
@@ -69,7 +77,9 @@ public:
             const std::string name = leaf_name(k->pointer);
             const std::string child_path = path + "/" + name;
             if (!obj.contains(name)) {
-                if (k->required) throw SceneError(child_path, "a " + describe_type(*k) + " (required)", "nothing");
+                if (k->required)
+                    throw SceneError(child_path, "a " + describe_type(*k) + " (required)",
+                                     "nothing");
                 if (!k->value) continue;  // optional, no default: absence has a meaning
                 obj[name] = *k->value;
             }
@@ -97,8 +107,8 @@ private:
     void number(const json& v, const KeySpec& k, const std::string& path, bool integer) {
         const std::string range = k.range.describe();
         const std::string unit = k.unit.empty() ? "" : " " + k.unit;
-        const std::string expected = (integer ? "an integer" : "a number") +
-                                     (range.empty() ? "" : " in " + range) + unit;
+        const std::string expected =
+            (integer ? "an integer" : "a number") + (range.empty() ? "" : " in " + range) + unit;
         if (integer ? !v.is_number_integer() : !v.is_number())
             throw SceneError(path, expected, describe_value(v));
         if (!k.range.contains(v.get<double>())) throw SceneError(path, expected, v.dump());
@@ -124,15 +134,21 @@ private:
                 if (!v.is_string() || v.get<std::string>().empty())
                     throw SceneError(path, "a non-empty string", describe_value(v));
                 break;
-            case ValueType::Number: number(v, k, path, false); break;
-            case ValueType::Integer: number(v, k, path, true); break;
+            case ValueType::Number:
+                number(v, k, path, false);
+                break;
+            case ValueType::Integer:
+                number(v, k, path, true);
+                break;
             case ValueType::Bool:
                 if (!v.is_boolean()) throw SceneError(path, "true or false", describe_value(v));
                 break;
             case ValueType::Vec3:
                 if (!v.is_array() || v.size() != 3)
-                    throw SceneError(path, "an array of 3 numbers" + unit_suffix(k), describe_value(v));
-                for (size_t i = 0; i < 3; ++i) number(v[i], k, fmt::format("{}/{}", path, i), false);
+                    throw SceneError(path, "an array of 3 numbers" + unit_suffix(k),
+                                     describe_value(v));
+                for (size_t i = 0; i < 3; ++i)
+                    number(v[i], k, fmt::format("{}/{}", path, i), false);
                 break;
             case ValueType::Enum: {
                 const bool ok = v.is_string() && std::find(k.options.begin(), k.options.end(),
@@ -140,13 +156,17 @@ private:
                 if (!ok) throw SceneError(path, describe_type(k), describe_value(v));
                 break;
             }
-            case ValueType::Object: object(v, table.at(k.pointer), path); break;
+            case ValueType::Object:
+                object(v, table.at(k.pointer), path);
+                break;
             case ValueType::ObjectArray:
                 if (!v.is_array()) throw SceneError(path, "an array of objects", describe_value(v));
                 for (size_t i = 0; i < v.size(); ++i)
                     object(v[i], table.at(k.pointer + "/[]"), fmt::format("{}/{}", path, i));
                 break;
-            case ValueType::Shape: shape(v, path); break;
+            case ValueType::Shape:
+                shape(v, path);
+                break;
             case ValueType::ShapeArray:
                 if (!v.is_array() || v.empty())
                     throw SceneError(path, "a non-empty array of shapes", describe_value(v));
@@ -155,7 +175,9 @@ private:
         }
     }
 
-    static std::string unit_suffix(const KeySpec& k) { return k.unit.empty() ? "" : " (" + k.unit + ")"; }
+    static std::string unit_suffix(const KeySpec& k) {
+        return k.unit.empty() ? "" : " (" + k.unit + ")";
+    }
 };
 
 }  // namespace

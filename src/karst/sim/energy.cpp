@@ -11,8 +11,10 @@ Energy mechanical_energy(const Model& model, const State& state) {
     const FluidParticles& f = state.fluid;
     const PorousParticles& p = state.porous.particles;
     Energy e;
-    e.kinetic = deterministic_sum(f.size(), Real(0), [&](Index i) { return 0.5 * f.mass[i] * f.v[i].squaredNorm(); });
-    e.potential = deterministic_sum(f.size(), Real(0), [&](Index i) { return -f.mass[i] * g.dot(f.x[i]); });
+    e.kinetic = deterministic_sum(f.size(), Real(0),
+                                  [&](Index i) { return 0.5 * f.mass[i] * f.v[i].squaredNorm(); });
+    e.potential =
+        deterministic_sum(f.size(), Real(0), [&](Index i) { return -f.mass[i] * g.dot(f.x[i]); });
     // An anchored fragment's particles move only as its quasi-static Biot displacement says
     // (their velocity spreads a call's u over dt_B, for the fluid's sake): no inertia, no
     // kinetic energy. Free fragments carry theirs.
@@ -21,7 +23,9 @@ Energy mechanical_energy(const Model& model, const State& state) {
         if (fragments[p.fragment[i]].anchored) return Real(0);
         return 0.5 * (p.solid_mass[i] + p.absorbed_mass[i]) * p.v[i].squaredNorm();
     });
-    e.potential += deterministic_sum(p.size(), Real(0), [&](Index i) { return -(p.solid_mass[i] + p.absorbed_mass[i]) * g.dot(p.x[i]); });
+    e.potential += deterministic_sum(p.size(), Real(0), [&](Index i) {
+        return -(p.solid_mass[i] + p.absorbed_mass[i]) * g.dot(p.x[i]);
+    });
     return e;
 }
 
@@ -39,7 +43,8 @@ void EnergyAccount::add(const Energy& e) {
     m_released = std::max(m_released, m_start.kinetic + m_start.potential - e.potential);
     m_largest_gain = std::max(m_largest_gain, e.total() - m_lowest);
     m_largest_rise = std::max(m_largest_rise, e.total() - m_start.total());
-    if (m_released > 0) m_worst_ratio = std::max(m_worst_ratio, (e.total() - m_lowest) / m_released);
+    if (m_released > 0)
+        m_worst_ratio = std::max(m_worst_ratio, (e.total() - m_lowest) / m_released);
     m_lowest = std::min(m_lowest, e.total());
 }
 

@@ -23,7 +23,8 @@ constexpr Real inf = std::numeric_limits<Real>::infinity();
 /// Packs a lattice index into one key (21 bits per axis, offset so negatives fit).
 std::uint64_t lattice_key(const LatticeIndex& i) {
     constexpr std::int64_t off = 1 << 20;
-    return std::uint64_t(i[0] + off) | std::uint64_t(i[1] + off) << 21 | std::uint64_t(i[2] + off) << 42;
+    return std::uint64_t(i[0] + off) | std::uint64_t(i[1] + off) << 21 |
+           std::uint64_t(i[2] + off) << 42;
 }
 
 /// Signed-distance band that a wall's particles fill (method: Akinci 2012 boundary skin).
@@ -35,17 +36,20 @@ std::pair<Real, Real> wall_band(const Wall& w, Real dx) {
 void check_particle_budget(const Scene& s) {
     const Real dx = s.particle_spacing;
     double total = 0;
-    for (const FluidBlock& b : s.fluid_blocks) total += estimate_lattice_count(b.shape, dx, -inf, 0);
-    for (const PorousSolid& p : s.porous_solids) total += estimate_lattice_count(p.shape, dx, -inf, 0);
+    for (const FluidBlock& b : s.fluid_blocks)
+        total += estimate_lattice_count(b.shape, dx, -inf, 0);
+    for (const PorousSolid& p : s.porous_solids)
+        total += estimate_lattice_count(p.shape, dx, -inf, 0);
     for (const Wall& w : s.walls) {
         const auto [lo, hi] = wall_band(w, dx);
         total += estimate_lattice_count(w.shape, dx, lo, hi);
         if (total > k_max_particles) break;
     }
     if (total > k_max_particles)
-        throw SceneError("/particle_spacing",
-                         fmt::format("a spacing giving at most {:g} million particles", k_max_particles / 1e6),
-                         fmt::format("{} m, which gives about {:.3g} million", dx, total / 1e6));
+        throw SceneError(
+            "/particle_spacing",
+            fmt::format("a spacing giving at most {:g} million particles", k_max_particles / 1e6),
+            fmt::format("{} m, which gives about {:.3g} million", dx, total / 1e6));
 }
 
 /// Fluid blocks and porous solids on the scene lattice; no lattice site may be taken twice.
@@ -55,26 +59,32 @@ void sample_fluid_and_solids(const Scene& s, Model& m) {
     auto sample = [&](const Shape& shape, const std::string& path, const auto& take) {
         const auto points = sample_lattice(shape, dx, -inf, 0);
         if (points.empty())
-            throw SceneError(path + "/shape", fmt::format("a shape holding at least one particle at spacing {} m", dx),
-                             "an empty shape");
+            throw SceneError(
+                path + "/shape",
+                fmt::format("a shape holding at least one particle at spacing {} m", dx),
+                "an empty shape");
         for (const LatticeIndex& p : points) {
             const auto [it, fresh] = owner.emplace(lattice_key(p), path);
             if (!fresh)
-                throw SceneError(path + "/shape", "fluid blocks and porous solids that do not overlap",
-                                 fmt::format("an overlap with {} near {}", it->second, fmt::streamed(lattice_point(p, dx).transpose())));
+                throw SceneError(path + "/shape",
+                                 "fluid blocks and porous solids that do not overlap",
+                                 fmt::format("an overlap with {} near {}", it->second,
+                                             fmt::streamed(lattice_point(p, dx).transpose())));
             take(lattice_point(p, dx));
         }
     };
     for (const FluidBlock& block : s.fluid_blocks)
         sample(block.shape, block.path, [&](const Vec3& x) {
-            m.initial_x.push_back(x), m.initial_v.push_back(block.velocity), m.initial_concentration.push_back(block.concentration);
+            m.initial_x.push_back(x), m.initial_v.push_back(block.velocity),
+                m.initial_concentration.push_back(block.concentration);
         });
     // Porous solids sit on the exact lattice: jitter would give the mesh interior slivers
     // (pfem/box_nodes.hpp says why).
     for (size_t i = 0; i < s.porous_solids.size(); ++i) {
         PorousBody body;
         body.solid = Index(i);
-        sample(s.porous_solids[i].shape, s.porous_solids[i].path, [&](const Vec3& x) { body.rest_x.push_back(x); });
+        sample(s.porous_solids[i].shape, s.porous_solids[i].path,
+               [&](const Vec3& x) { body.rest_x.push_back(x); });
         m.porous.push_back(std::move(body));
     }
 }
@@ -86,10 +96,13 @@ void sample_walls(const Scene& s, Model& m, std::vector<int>& layers) {
         const auto [lo, hi] = wall_band(w, dx);
         const auto points = sample_lattice(w.shape, dx, lo, hi);
         if (points.empty())
-            throw SceneError(w.path + "/shape", fmt::format("a shape holding at least one particle at spacing {} m", dx),
-                             "an empty shape");
+            throw SceneError(
+                w.path + "/shape",
+                fmt::format("a shape holding at least one particle at spacing {} m", dx),
+                "an empty shape");
         for (const LatticeIndex& p : points)
-            if (taken.insert(lattice_key(p)).second) m.walls.x.push_back(lattice_point(p, dx)), layers.push_back(w.layers);
+            if (taken.insert(lattice_key(p)).second)
+                m.walls.x.push_back(lattice_point(p, dx)), layers.push_back(w.layers);
     }
     // Porous solids must not overlap an obstacle or stick out of a container.
     for (const Wall& w : s.walls)
@@ -97,10 +110,12 @@ void sample_walls(const Scene& s, Model& m, std::vector<int>& layers) {
             for (const Vec3& x : body.rest_x) {
                 const Real d = w.shape.signed_distance(x);
                 if (w.kind == Wall::Kind::Container ? d > 0 : d <= 0)
-                    throw SceneError(s.porous_solids[body.solid].path + "/shape",
-                                     w.kind == Wall::Kind::Container ? fmt::format("a solid inside the container {}", w.path)
-                                                                     : fmt::format("a solid not overlapping the obstacle {}", w.path),
-                                     fmt::format("a particle at {}", fmt::streamed(x.transpose())));
+                    throw SceneError(
+                        s.porous_solids[body.solid].path + "/shape",
+                        w.kind == Wall::Kind::Container
+                            ? fmt::format("a solid inside the container {}", w.path)
+                            : fmt::format("a solid not overlapping the obstacle {}", w.path),
+                        fmt::format("a particle at {}", fmt::streamed(x.transpose())));
             }
     // Fluid must not start inside an obstacle, nor outside a container's cavity.
     for (const Wall& w : s.walls) {
@@ -108,10 +123,11 @@ void sample_walls(const Scene& s, Model& m, std::vector<int>& layers) {
             const Real d = w.shape.signed_distance(m.initial_x[i]);
             const bool bad = w.kind == Wall::Kind::Container ? d > 0 : d <= 0;
             if (bad)
-                throw SceneError(w.path + "/shape",
-                                 w.kind == Wall::Kind::Container ? "a container holding all fluid"
-                                                                 : "an obstacle not overlapping fluid",
-                                 fmt::format("fluid at {}", fmt::streamed(m.initial_x[i].transpose())));
+                throw SceneError(
+                    w.path + "/shape",
+                    w.kind == Wall::Kind::Container ? "a container holding all fluid"
+                                                    : "an obstacle not overlapping fluid",
+                    fmt::format("fluid at {}", fmt::streamed(m.initial_x[i].transpose())));
         }
     }
 }
@@ -134,7 +150,8 @@ Real prototype_sum(const CubicKernel& kernel, Real dx) {
 /// lattice: V_b = 1 / sum_l W_kl exceeds dx^3 (the wall sees fewer neighbours than the fluid it
 /// stands for), so the first fluid layer starts over-dense (6 % for one layer at h = 2 dx, 15 %
 /// in corners), and PCISPH spends its first steps in a violent correction. The factor
-/// gamma = (rho0 - fluid part) / (wall part) on a flat prototype wall makes that layer exactly rho0.
+/// gamma = (rho0 - fluid part) / (wall part) on a flat prototype wall makes that layer exactly
+/// rho0.
 Real akinci_calibration(const CubicKernel& W, Real dx, Real rho0, Real mass, int layers) {
     const int reach = 3;  // lattice offsets beyond the support (h = 2 dx) contribute nothing
     // Wall particles at z = -(l + 1/2) dx, l < layers; fluid at z = (k + 1/2) dx, k >= 0.
@@ -142,14 +159,16 @@ Real akinci_calibration(const CubicKernel& W, Real dx, Real rho0, Real mass, int
         Real sum = 0;
         for (int l = 0; l < layers; ++l)
             for (int j = -reach; j <= reach; ++j)
-                for (int i = -reach; i <= reach; ++i) sum += W.w((Vec3(i, j, l - layer) * dx).norm());
+                for (int i = -reach; i <= reach; ++i)
+                    sum += W.w((Vec3(i, j, l - layer) * dx).norm());
         return 1 / sum;
     };
     Real fluid = 0, wall = 0;
     for (int j = -reach; j <= reach; ++j)
         for (int i = -reach; i <= reach; ++i) {
             for (int k = 0; k <= reach; ++k) fluid += mass * W.w((Vec3(i, j, k) * dx).norm());
-            for (int l = 0; l < layers; ++l) wall += rho0 * wall_volume(l) * W.w((Vec3(i, j, l + 1) * dx).norm());
+            for (int l = 0; l < layers; ++l)
+                wall += rho0 * wall_volume(l) * W.w((Vec3(i, j, l + 1) * dx).norm());
         }
     return (rho0 - fluid) / wall;
 }
@@ -188,7 +207,8 @@ void compute_wall_volumes(Model& m, const std::vector<int>& layers) {
     parallel_for(w.size(), [&](Index k) {
         Real sum = m.kernel.w0();
         lists.for_each(k, [&](Index l) { sum += m.kernel.w((w.x[k] - w.x[l]).norm()); });
-        w.psi[k] = m.rho0 * (sorted_layers[k] == 1 ? gamma_thin / sum : std::min(m.lattice_volume, 1 / sum));
+        w.psi[k] = m.rho0 *
+                   (sorted_layers[k] == 1 ? gamma_thin / sum : std::min(m.lattice_volume, 1 / sum));
     });
 }
 
@@ -202,7 +222,9 @@ void set_up_porous_materials(Model& m) {
     }
     for (const PorousSolid& solid : m.scene.porous_solids) {
         m.pore_laws.push_back(pore_water_law(solid.material, m.rho0, m.scene.gravity));
-        m.dissolution.push_back({solid.material.dissolution_saturation, solid.material.dissolution_porosity, solid.material.solid_density});
+        m.dissolution.push_back({solid.material.dissolution_saturation,
+                                 solid.material.dissolution_porosity,
+                                 solid.material.solid_density});
     }
     m.porous_grid = UniformGrid(m.domain, reach);
 }
@@ -216,19 +238,25 @@ void check_biot_setup(const Model& m) {
         if (m.poroelastic_only()) {
             if (s.material.porosity < k_min_porosity)
                 throw SceneError(s.path + "/material/porosity",
-                                 "a porosity of at least 1e-4 in a poroelastic-only scene (an impermeable solid has no pore pressure)",
+                                 "a porosity of at least 1e-4 in a poroelastic-only scene (an "
+                                 "impermeable solid has no pore pressure)",
                                  fmt::format("{}", s.material.porosity));
             continue;
         }
         if (s.constraints.empty()) continue;
-        const char* why = !scene.poroelastic.coupled_fragments ? "/poroelastic/coupled_fragments is none"
-                          : !s.anchored                        ? "the solid is free (free fragments move rigidly)"
-                          : s.material.porosity < k_min_porosity ? "the solid is impermeable (porosity below 1e-4)"
-                                                                 : nullptr;
+        const char* why = !scene.poroelastic.coupled_fragments
+                              ? "/poroelastic/coupled_fragments is none"
+                          : !s.anchored ? "the solid is free (free fragments move rigidly)"
+                          : s.material.porosity < k_min_porosity
+                              ? "the solid is impermeable (porosity below 1e-4)"
+                              : nullptr;
         if (why)
-            throw SceneError(s.path + "/constraints",
-                             fmt::format("no Biot constraints here: {}, so no Biot problem is solved for this solid", why),
-                             fmt::format("{} constraints", s.constraints.size()));
+            throw SceneError(
+                s.path + "/constraints",
+                fmt::format(
+                    "no Biot constraints here: {}, so no Biot problem is solved for this solid",
+                    why),
+                fmt::format("{} constraints", s.constraints.size()));
     }
 }
 
@@ -246,7 +274,8 @@ Model build_model(const Scene& scene) {
     m.lattice_volume = lattice_volume(m.kernel, m.dx);
 
     if (scene.fluid_blocks.empty() && scene.walls.empty() && scene.porous_solids.empty())
-        throw SceneError("/fluid_blocks", "at least one fluid block, porous solid or wall", "an empty scene");
+        throw SceneError("/fluid_blocks", "at least one fluid block, porous solid or wall",
+                         "an empty scene");
     check_particle_budget(scene);
     sample_fluid_and_solids(scene, m);
     std::vector<int> wall_layers;  // per wall particle
@@ -263,8 +292,9 @@ Model build_model(const Scene& scene) {
     for (const auto* set : sets)
         for (const Vec3& x : *set)
             if (!m.domain.contains(x))
-                throw SceneError("/domain", "a box holding every particle",
-                                 fmt::format("a particle outside it at {}", fmt::streamed(x.transpose())));
+                throw SceneError(
+                    "/domain", "a box holding every particle",
+                    fmt::format("a particle outside it at {}", fmt::streamed(x.transpose())));
     m.grid = UniformGrid(m.domain, m.h);
     compute_wall_volumes(m, wall_layers);
     set_up_porous_materials(m);

@@ -23,18 +23,19 @@ struct WallParticles {
 
 /// The particles of one porous solid at rest (method.md §2). The PFEM mesh is built on rest_x.
 struct PorousBody {
-    Index solid = 0;              ///< index into scene.porous_solids
-    std::vector<Vec3> rest_x;     ///< (n), m
+    Index solid = 0;                      ///< index into scene.porous_solids
+    std::vector<Vec3> rest_x;             ///< (n), m
     std::vector<Mat3> body_permeability;  ///< (n) K0 (M12 / M28), m^2
 };
 
 struct Model {
     Scene scene;
-    Real dx = 0;                ///< particle spacing, m
-    Real h = 0;                 ///< support radius 2 dx, m
-    Real rho0 = 1000;           ///< kg/m^3
-    Real particle_mass = 0;     ///< m_f0 = rho0 dx^3, kg
-    Real lattice_volume = 0;    ///< dx^3 / (dx^3 sum_lattice W): a boundary lattice site's volume, m^3
+    Real dx = 0;             ///< particle spacing, m
+    Real h = 0;              ///< support radius 2 dx, m
+    Real rho0 = 1000;        ///< kg/m^3
+    Real particle_mass = 0;  ///< m_f0 = rho0 dx^3, kg
+    Real lattice_volume =
+        0;  ///< dx^3 / (dx^3 sum_lattice W): a boundary lattice site's volume, m^3
     CubicKernel kernel{1.0};
     /// |sum grad W|^2 + sum |grad W|^2 on a full lattice neighbourhood (1/m^8): the prototype
     /// particle of M8, fixed by the lattice, so delta(dt) is closed-form.
@@ -42,20 +43,21 @@ struct Model {
     Aabb domain;
     UniformGrid grid;
     WallParticles walls;
-    std::vector<Vec3> initial_x;  ///< fluid particles at t = 0, m
-    std::vector<Vec3> initial_v;  ///< m/s
+    std::vector<Vec3> initial_x;              ///< fluid particles at t = 0, m
+    std::vector<Vec3> initial_v;              ///< m/s
     std::vector<Real> initial_concentration;  ///< C = m_sol / m
     std::vector<PorousBody> porous;
     /// Per material (= per scene solid): the pore-water law and when it dissolves.
     std::vector<PoreWaterLaw> pore_laws;
     std::vector<DissolutionThreshold> dissolution;
-    UniformGrid porous_grid;      ///< cell = the longest porous kernel reach (M13), at least h
+    UniformGrid porous_grid;  ///< cell = the longest porous kernel reach (M13), at least h
     /// Porous solids run coupled with the fluid as rigid fragments; else they are poroelastic-only.
     bool coupled() const { return !porous.empty() && (!initial_x.empty() || any_free_solid()); }
     /// Porous solids alone, all anchored, no fluid: the Biot solver runs by itself.
     bool poroelastic_only() const { return !porous.empty() && !coupled(); }
     bool any_free_solid() const {
-        for (const PorousSolid& s : scene.porous_solids) if (!s.anchored) return true;
+        for (const PorousSolid& s : scene.porous_solids)
+            if (!s.anchored) return true;
         return false;
     }
 

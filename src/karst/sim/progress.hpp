@@ -9,13 +9,13 @@ namespace karst {
 
 struct ProgressInfo {
     int frame = 0;
-    double time = 0, end_time = 0;   ///< simulated, s
+    double time = 0, end_time = 0;  ///< simulated, s
     double steps_per_second = 0;
-    double mipps = 0;                ///< million particle-steps per second
-    double eta_seconds = 0;          ///< wall-clock seconds left
+    double mipps = 0;        ///< million particle-steps per second
+    double eta_seconds = 0;  ///< wall-clock seconds left
     long long particles = 0;
-    double absorbed_kg = -1;         ///< water soaked into porous solids so far; < 0: no porous solids
-    long long removed = 0;           ///< fluid particles that left the domain so far
+    double absorbed_kg = -1;  ///< water soaked into porous solids so far; < 0: no porous solids
+    long long removed = 0;    ///< fluid particles that left the domain so far
 };
 
 class ProgressLine {

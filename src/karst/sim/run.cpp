@@ -26,7 +26,8 @@ namespace karst {
 namespace {
 
 /// The conserved totals (method.md §4.7-4.8): water is the fluid's mass less its solute and
-/// the water it already gave (drained), plus the pore water; grains are the solute plus the porous particles' solid mass.
+/// the water it already gave (drained), plus the pore water; grains are the solute plus the porous
+/// particles' solid mass.
 struct MassTotals {
     Real water = 0, solute = 0, absorbed = 0, grains = 0;
 };
@@ -37,8 +38,10 @@ MassTotals mass_totals(const State& s) {
     MassTotals t;
     t.solute = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.solute[i]; });
     t.absorbed = deterministic_sum(p.size(), Real(0), [&](Index i) { return p.absorbed_mass[i]; });
-    t.water = deterministic_sum(f.size(), Real(0), [&](Index i) { return f.water(i); }) + t.absorbed;
-    t.grains = t.solute + deterministic_sum(p.size(), Real(0), [&](Index i) { return p.solid_mass[i]; });
+    t.water =
+        deterministic_sum(f.size(), Real(0), [&](Index i) { return f.water(i); }) + t.absorbed;
+    t.grains =
+        t.solute + deterministic_sum(p.size(), Real(0), [&](Index i) { return p.solid_mass[i]; });
     return t;
 }
 
@@ -49,8 +52,11 @@ Index live_fragments(const State& s) {
 }
 
 nlohmann::json biot_stats(const PfemTimings& t) {
-    return {{"calls", t.biot_calls}, {"iterations", t.biot_iterations}, {"remeshes", t.remeshes},
-            {"mean_iterations", t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0}, {"all_converged", t.all_converged}};
+    return {{"calls", t.biot_calls},
+            {"iterations", t.biot_iterations},
+            {"remeshes", t.remeshes},
+            {"mean_iterations", t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0},
+            {"all_converged", t.all_converged}};
 }
 
 /// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current
@@ -69,14 +75,17 @@ PointSet porous_frame(const Model& model, const State& state) {
 RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     Scene scene = scene_in;
     if (opt.end_time) {
-        if (!(*opt.end_time >= 0)) throw SceneError("--end-time", "a time >= 0 s", fmt::format("{}", *opt.end_time));
+        if (!(*opt.end_time >= 0))
+            throw SceneError("--end-time", "a time >= 0 s", fmt::format("{}", *opt.end_time));
         scene.time.end = *opt.end_time;
     }
     if (opt.fps) {
-        if (!(*opt.fps > 0)) throw SceneError("--fps", "a frame rate > 0", fmt::format("{}", *opt.fps));
+        if (!(*opt.fps > 0))
+            throw SceneError("--fps", "a frame rate > 0", fmt::format("{}", *opt.fps));
         scene.output.fps = *opt.fps;
     }
-    if (opt.threads < 0) throw SceneError("--threads", "a thread count >= 0", fmt::format("{}", opt.threads));
+    if (opt.threads < 0)
+        throw SceneError("--threads", "a thread count >= 0", fmt::format("{}", opt.threads));
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
@@ -96,25 +105,32 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     bool energy_warned = false, removed_warned = false;
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
-        log.kinetic_energy = e.kinetic, log.potential_energy = e.potential, log.removed = state.removed;
+        log.kinetic_energy = e.kinetic, log.potential_energy = e.potential,
+        log.removed = state.removed;
         std::tie(log.speed_p99, log.max_speed) = fluid_speed_p99_and_max(state.fluid);
         energy.add(e);
         if (!energy_warned && energy.gained_more_than(0.05)) {
             energy_warned = true;
-            progress.warn(fmt::format("t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the {:.3g} J "
-                                      "released so far (log.csv has the account)",
-                                      state.time, energy.largest_gain(), 100 * energy.worst_ratio(), energy.released()));
+            progress.warn(fmt::format(
+                "t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the "
+                "{:.3g} J "
+                "released so far (log.csv has the account)",
+                state.time, energy.largest_gain(), 100 * energy.worst_ratio(), energy.released()));
         }
         if (!removed_warned && state.removed > 0) {
             removed_warned = true;
-            progress.warn(fmt::format("t = {:.4g} s: fluid left the domain: {} particles ({:.3g} kg) so far; stats.json "
-                                      "counts.removed has the total", state.time, state.removed, state.removed * model.particle_mass));
+            progress.warn(fmt::format(
+                "t = {:.4g} s: fluid left the domain: {} particles ({:.3g} kg) so far; stats.json "
+                "counts.removed has the total",
+                state.time, state.removed, state.removed * model.particle_mass));
         }
         PointSet porous_points;
         if (porous) porous_points = porous_frame(model, state);
         MeshFrame mesh;
         if (meshes) append_structure_meshes(model, state, mesh);
-        out.write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr, porous ? &porous_points : nullptr}, log);
+        out.write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr,
+                         porous ? &porous_points : nullptr},
+                        log);
     };
 
     // Densities of the initial state, so frame 0 shows them.
@@ -141,35 +157,52 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         const double step_seconds = profile.total();
         const MassTotals final_totals = mass_totals(state);
         nlohmann::json phases;
-        for (size_t s = 0; s < size_t(Stage::Count); ++s) phases[std::string(k_stage_names[s])] = profile.seconds[s];
+        for (size_t s = 0; s < size_t(Stage::Count); ++s)
+            phases[std::string(k_stage_names[s])] = profile.seconds[s];
         const PfemTimings& pfem = state.structures.timings;
         const MeshQuality quality = structure_mesh_quality(state);
         phases["meshing"] = pfem.meshing, phases["assembly"] = pfem.assembly;
         phases["factorisation"] = pfem.factorisation, phases["iterations"] = pfem.iterations;
         return nlohmann::json{
             {"scene", scene.name},
-            {"counts", {{"fluid", state.fluid.size()}, {"boundary", model.walls.size()}, {"porous", state.porous.size()},
-                        {"elements", quality.elements}, {"fragments", live_fragments(state)}, {"removed", state.removed},
-                        {"pushed_back", state.pushed_back},
-                        {"porous_removed", state.porous.removed}, {"dissolved", state.porous.dissolved},
-                        {"fluid_drained", state.porous.fluid_deleted}}},
+            {"counts",
+             {{"fluid", state.fluid.size()},
+              {"boundary", model.walls.size()},
+              {"porous", state.porous.size()},
+              {"elements", quality.elements},
+              {"fragments", live_fragments(state)},
+              {"removed", state.removed},
+              {"pushed_back", state.pushed_back},
+              {"porous_removed", state.porous.removed},
+              {"dissolved", state.porous.dissolved},
+              {"fluid_drained", state.porous.fluid_deleted}}},
             {"steps", state.steps},
             {"frames", out.frames()},
             {"sim_time", state.time},
             {"wall_time", wall.seconds()},
             {"phases", phases},
-            {"mass", {{"water_initial", initial.water}, {"water_final", final_totals.water},
-                      {"absorbed", state.porous.absorbed},
-                      {"absorbed_initial", initial.absorbed}, {"absorbed_final", final_totals.absorbed},
-                      {"solute_initial", initial.solute}, {"solute_final", final_totals.solute},
-                      {"grains_initial", initial.grains}, {"grains_final", final_totals.grains}}},
+            {"mass",
+             {{"water_initial", initial.water},
+              {"water_final", final_totals.water},
+              {"absorbed", state.porous.absorbed},
+              {"absorbed_initial", initial.absorbed},
+              {"absorbed_final", final_totals.absorbed},
+              {"solute_initial", initial.solute},
+              {"solute_final", final_totals.solute},
+              {"grains_initial", initial.grains},
+              {"grains_final", final_totals.grains}}},
             {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
             {"biot", biot_stats(pfem)},
-            {"mesh", {{"kept", quality.kept}, {"polyhedra", quality.polyhedra}, {"slivers_dropped", quality.slivers_dropped},
-                      {"interior_slivers", quality.interior_slivers}}},
+            {"mesh",
+             {{"kept", quality.kept},
+              {"polyhedra", quality.polyhedra},
+              {"slivers_dropped", quality.slivers_dropped},
+              {"interior_slivers", quality.interior_slivers}}},
             {"max_density_error", max_density_error},
-            {"energy", {{"released", energy.released()}, {"largest_gain", energy.largest_gain()},
-                        {"largest_rise_over_start", energy.largest_rise_over_start()}}},
+            {"energy",
+             {{"released", energy.released()},
+              {"largest_gain", energy.largest_gain()},
+              {"largest_rise_over_start", energy.largest_rise_over_start()}}},
             {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
             {"threads", ThreadLimit::active_threads()},
             {"version", KARST_VERSION},
@@ -193,7 +226,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 state.fluid = last_good;
                 if (porous) state.porous = last_good_porous;
                 state.time = last_good_time;
-                write_frame({state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
+                write_frame(
+                    {state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
                 throw;
             }
             max_density_error = std::max(max_density_error, report.max_density_error);
@@ -204,16 +238,20 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
 
             const bool frame_due = state.time >= frame_time - 1e-9 * dt;
             if (frame_due) {
-                write_frame({state.time, report.dt, state.steps, state.fluid.size(), frame_density_error,
-                             frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
+                write_frame(
+                    {state.time, report.dt, state.steps, state.fluid.size(), frame_density_error,
+                     frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
                 ++next_frame;
                 frame_density_error = 0, frame_particle_steps = 0, frame_step_seconds = 0;
             }
             const double elapsed = stepping.seconds();
             const double rate = state.time / std::max(elapsed, 1e-9);
-            progress.update({out.frames() - 1, state.time, end, state.steps / std::max(elapsed, 1e-9),
-                             particle_steps / std::max(elapsed, 1e-9) / 1e6, (end - state.time) / std::max(rate, 1e-12),
-                             fluid_frames ? state.fluid.size() : state.porous.size(), porous ? state.porous.absorbed : -1.0, state.removed});
+            progress.update({out.frames() - 1, state.time, end,
+                             state.steps / std::max(elapsed, 1e-9),
+                             particle_steps / std::max(elapsed, 1e-9) / 1e6,
+                             (end - state.time) / std::max(rate, 1e-12),
+                             fluid_frames ? state.fluid.size() : state.porous.size(),
+                             porous ? state.porous.absorbed : -1.0, state.removed});
         }
     } catch (const WatchdogError& e) {
         progress.finish();

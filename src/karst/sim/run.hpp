@@ -20,9 +20,9 @@ struct RunOptions {
 
 struct RunResult {
     bool ok = true;
-    std::string failure;       ///< watchdog message when !ok
+    std::string failure;  ///< watchdog message when !ok
     std::filesystem::path out_dir;
-    nlohmann::json stats;      ///< what stats.json holds
+    nlohmann::json stats;  ///< what stats.json holds
 };
 
 /// Runs `scene` to its end time, writing frames. Throws SceneError before writing anything if

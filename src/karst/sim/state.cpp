@@ -20,7 +20,8 @@ void make_porous(const Model& model, PorousState& porous, std::int64_t& next_id)
         const Index n = p.size() - first;
         for (Index i = first; i < p.size(); ++i) p.id[i] = next_id++;
         std::vector<Real> mass(n);
-        for (Index i = 0; i < n; ++i) mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];
+        for (Index i = 0; i < n; ++i)
+            mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];
         std::vector<Vec3> rest;
         Fragment f = fragment_at_rest({p.x.data() + first, size_t(n)}, mass, rest, model.dx);
         std::copy(rest.begin(), rest.end(), p.rest.begin() + first);

@@ -55,7 +55,9 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     PorousState& porous = state.porous;
     PorousScratch& s = state.porous_scratch;
     FluidExchange fluid{state.fluid, s.porous_fluid, model.particle_mass};
-    if (!s.flow) s.flow.emplace(model.pore_laws, model.h, model.dx, model.scene.paper_eq20 ? PairFlux::PaperEq20 : PairFlux::Darcy);
+    if (!s.flow)
+        s.flow.emplace(model.pore_laws, model.h, model.dx,
+                       model.scene.paper_eq20 ? PairFlux::PaperEq20 : PairFlux::Darcy);
     PoreFlow& flow = *s.flow;
     if (s.pairs_stale) {
         CellRanges cells;
@@ -68,14 +70,17 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
     // Fragments in contact exchange water too (r < 1.1 dx), through pairs found anew each step.
     const bool several = state.porous.fragments.size() > 1;
     const PoreFlowReport report =
-        several ? flow.advance(porous.particles,
-                               merge_pairs(s.fragment_pairs, flow.pairs(porous.particles, s.porous_porous, PairSelection::AcrossFragments)),
-                               dt, &fluid)
+        several ? flow.advance(
+                      porous.particles,
+                      merge_pairs(s.fragment_pairs, flow.pairs(porous.particles, s.porous_porous,
+                                                               PairSelection::AcrossFragments)),
+                      dt, &fluid)
                 : flow.advance(porous.particles, s.fragment_pairs, dt, &fluid);
     porous.absorbed += report.absorbed;
     porous.pore_substeps += report.substeps;
-    porous.fluid_deleted += drain_fluid_particles(state.fluid, porous.particles, report.main_receiver,
-                                                  state.scratch.fluid_fluid, model.particle_mass);
+    porous.fluid_deleted +=
+        drain_fluid_particles(state.fluid, porous.particles, report.main_receiver,
+                              state.scratch.fluid_fluid, model.particle_mass);
     // Which porous particles may dissolve later in the step, while the lists hold.
     mark_exposed(porous.particles, state.fluid, s.porous_fluid, model.h, model.dx, s.exposed);
 }
@@ -83,8 +88,8 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
 /// §3 step 9: saturated, porous-enough particles become muddy fluid; their fragments lose them.
 void dissolve_particles(const Model& model, State& state) {
     DissolutionSettings settings{model.dissolution, model.particle_mass, model.dx};
-    const DissolutionReport r =
-        dissolve(state.porous.particles, state.fluid, model.pore_laws, settings, state.next_id, state.porous_scratch.exposed);
+    const DissolutionReport r = dissolve(state.porous.particles, state.fluid, model.pore_laws,
+                                         settings, state.next_id, state.porous_scratch.exposed);
     state.porous.dissolved += r.dissolved;
     if (r.dissolved > 0) state.porous_scratch.pairs_stale = true;
 }
@@ -142,10 +147,13 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     bool converged = false;
     timed(profile, Stage::PressureSolve, [&] {
         for (int halvings = 0;; ++halvings) {
-            pressure = fs.solver == FluidSettings::Solver::Dfsph ? solve_pressure_dfsph(model, state, dt)
-                                                                 : solve_pressure_pcisph(model, state, dt);
-            converged = pressure.max_density_error <= std::max(fs.max_density_error, k_step_density_error);
-            if (converged || model.scene.time.fixed_dt || halvings == k_max_step_halvings || dt / 2 < model.scene.time.dt_min)
+            pressure = fs.solver == FluidSettings::Solver::Dfsph
+                           ? solve_pressure_dfsph(model, state, dt)
+                           : solve_pressure_pcisph(model, state, dt);
+            converged =
+                pressure.max_density_error <= std::max(fs.max_density_error, k_step_density_error);
+            if (converged || model.scene.time.fixed_dt || halvings == k_max_step_halvings ||
+                dt / 2 < model.scene.time.dt_min)
                 break;
             dt /= 2;
         }
@@ -162,12 +170,15 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         timed(profile, Stage::FluidReactions, [&] { compute_fluid_reactions(model, state); });
         // 8. Pore flow, absorption and drained fluid (§4.7), before anything moves.
         timed(profile, Stage::PoreFlow, [&] { pore_flow_and_absorption(model, state, dt); });
-        check_scalars(state.porous.particles.absorbed_mass, {}, Stage::PoreFlow, t, "absorbed mass");
+        check_scalars(state.porous.particles.absorbed_mass, {}, Stage::PoreFlow, t,
+                      "absorbed mass");
     }
 
     // 5. Symplectic Euler; particles leaving the domain, or drained, are removed (§4.4).
-    state.a_max = timed(profile, Stage::Integrate, [&] { return integrate_fluid(model, state, dt); });
-    check_vectors(state.fluid.v, state.fluid.id, Stage::Integrate, t + dt, "velocity", model.scene.max_speed);
+    state.a_max =
+        timed(profile, Stage::Integrate, [&] { return integrate_fluid(model, state, dt); });
+    check_vectors(state.fluid.v, state.fluid.id, Stage::Integrate, t + dt, "velocity",
+                  model.scene.max_speed);
     check_vectors(state.fluid.x, state.fluid.id, Stage::Integrate, t + dt, "position");
 
     if (porous) {

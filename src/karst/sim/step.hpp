@@ -6,10 +6,10 @@
 namespace karst {
 
 struct StepReport {
-    Real dt = 0;                 ///< s
+    Real dt = 0;  ///< s
     int pressure_iterations = 0;
     int divergence_iterations = 0;  ///< DFSPH only
-    Real max_density_error = 0;  ///< fraction of rho0
+    Real max_density_error = 0;     ///< fraction of rho0
 };
 
 /// Advances the state by one step of length dt (method.md §3, and §5 for the anchored

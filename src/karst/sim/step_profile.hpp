@@ -6,13 +6,24 @@
 namespace karst {
 
 enum class Stage {
-    Neighbours, Density, SoluteDiffusion, NonPressureForces, PressureSolve, FluidReactions, PoreFlow, Integrate,
-    Fragments, Dissolution, Structure, Count
+    Neighbours,
+    Density,
+    SoluteDiffusion,
+    NonPressureForces,
+    PressureSolve,
+    FluidReactions,
+    PoreFlow,
+    Integrate,
+    Fragments,
+    Dissolution,
+    Structure,
+    Count
 };
 
 inline constexpr std::array<std::string_view, size_t(Stage::Count)> k_stage_names{
-    "neighbours", "density", "solute_diffusion", "non_pressure_forces", "pressure_solve", "fluid_reactions",
-    "pore_flow", "integrate", "fragments", "dissolution", "structure"};
+    "neighbours",     "density",         "solute_diffusion", "non_pressure_forces",
+    "pressure_solve", "fluid_reactions", "pore_flow",        "integrate",
+    "fragments",      "dissolution",     "structure"};
 
 struct StepProfile {
     std::array<double, size_t(Stage::Count)> seconds{};

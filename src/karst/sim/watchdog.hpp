@@ -11,7 +11,8 @@
 namespace karst {
 
 struct WatchdogError : std::runtime_error {
-    WatchdogError(std::string_view stage, std::int64_t particle_id, Real time, const std::string& what);
+    WatchdogError(std::string_view stage, std::int64_t particle_id, Real time,
+                  const std::string& what);
     std::string stage;
     std::int64_t particle_id;
     Real time;
@@ -20,9 +21,9 @@ struct WatchdogError : std::runtime_error {
 /// Throws WatchdogError if any entry of `values` is not finite (or, when max_norm > 0, longer
 /// than max_norm), naming `quantity`, the stage and the particle's id (its index when `id` is
 /// empty, as for porous particles).
-void check_vectors(const std::vector<Vec3>& values, const std::vector<std::int64_t>& id, Stage stage,
-                   Real time, const char* quantity, Real max_norm = 0);
-void check_scalars(const std::vector<Real>& values, const std::vector<std::int64_t>& id, Stage stage,
-                   Real time, const char* quantity);
+void check_vectors(const std::vector<Vec3>& values, const std::vector<std::int64_t>& id,
+                   Stage stage, Real time, const char* quantity, Real max_norm = 0);
+void check_scalars(const std::vector<Real>& values, const std::vector<std::int64_t>& id,
+                   Stage stage, Real time, const char* quantity);
 
 }  // namespace karst

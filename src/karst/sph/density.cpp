@@ -16,8 +16,10 @@ void compute_density(const Model& model, const State& state, const std::vector<V
         const Vec3 xi = x[i];
         Real sum = f.sph_mass[i] * W.w0();
         s.fluid_fluid.for_each(i, [&](Index j) { sum += f.sph_mass[j] * W.w((xi - x[j]).norm()); });
-        s.fluid_wall.for_each(i, [&](Index k) { sum += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm()); });
-        s.fluid_porous.for_each(i, [&](Index k) { sum += psi[k] * W.w((xi - porous_x[k]).norm()); });
+        s.fluid_wall.for_each(
+            i, [&](Index k) { sum += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm()); });
+        s.fluid_porous.for_each(i,
+                                [&](Index k) { sum += psi[k] * W.w((xi - porous_x[k]).norm()); });
         rho[i] = sum;
     });
 }

@@ -10,13 +10,14 @@ namespace karst {
 namespace {
 
 /// -d rho*_i / d p_i = dt^2 / rho0^2 (g_i.G_i + m_i sum_j m_j |grad W_ij|^2), with
-/// g_i = sum_j m_j grad W_ij + sum_k Psi_k grad W_ik and G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik
-/// (a boundary neighbour carries p_i + p_ik, both rising with p_i). Fixed for the step.
+/// g_i = sum_j m_j grad W_ij + sum_k Psi_k grad W_ik and G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k
+/// grad W_ik (a boundary neighbour carries p_i + p_ik, both rising with p_i). Fixed for the step.
 void compute_diagonal(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0, scale = dt * dt / rho0_2;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
+              cap_p = s.fluid_porous.capacity;
     const std::vector<Vec3>& porous_x = state.porous.particles.x;
     s.diagonal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
@@ -32,23 +33,29 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
         });
         const Real* cw = s.wall_coefficient.data() + i * cap_w;
         k = 0;
-        s.fluid_wall.for_each(i, [&](Index w) { boundary += (rho0_2 * cw[k++]) * (xi - model.walls.x[w]); });
+        s.fluid_wall.for_each(
+            i, [&](Index w) { boundary += (rho0_2 * cw[k++]) * (xi - model.walls.x[w]); });
         const Real* cp = s.porous_coefficient.data() + i * cap_p;
         k = 0;
-        s.fluid_porous.for_each(i, [&](Index w) { boundary += (rho0_2 * cp[k++]) * (xi - porous_x[w]); });
-        // sum_j m_i m_j |grad W_ij|^2, read as (m_i / m_0) sum_j |m_j grad W_ij|^2 (equal for water).
+        s.fluid_porous.for_each(
+            i, [&](Index w) { boundary += (rho0_2 * cp[k++]) * (xi - porous_x[w]); });
+        // sum_j m_i m_j |grad W_ij|^2, read as (m_i / m_0) sum_j |m_j grad W_ij|^2 (equal for
+        // water).
         const Real own = (fluid + boundary).dot(fluid + 2 * boundary);
-        s.diagonal[i] = scale * (std::max(own, Real(0)) + squares * f.sph_mass[i] / model.particle_mass);
+        s.diagonal[i] =
+            scale * (std::max(own, Real(0)) + squares * f.sph_mass[i] / model.particle_mass);
     });
 }
 
 /// dt D_i(v) = dt (sum_j m_j (v_i - v_j).grad W_ij + sum_k Psi_k (v_i - v_k).grad W_ik): the
 /// density change that the velocities v would make over dt, kg/m^3.
-Real density_change(const Model& model, const State& state, const std::vector<Vec3>& v, Index i, Real dt) {
+Real density_change(const Model& model, const State& state, const std::vector<Vec3>& v, Index i,
+                    Real dt) {
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
+              cap_p = s.fluid_porous.capacity;
     const Vec3 xi = f.x[i], vi = v[i];
     Real sum = 0;
     const Real* cf = s.pair_coefficient.data() + i * cap_f;
@@ -60,7 +67,8 @@ Real density_change(const Model& model, const State& state, const std::vector<Ve
     const PorousParticles& porous = state.porous.particles;
     const Real* cp = s.porous_coefficient.data() + i * cap_p;
     k = 0;
-    s.fluid_porous.for_each(i, [&](Index w) { sum += cp[k++] * (vi - porous.v[w]).dot(xi - porous.x[w]); });
+    s.fluid_porous.for_each(
+        i, [&](Index w) { sum += cp[k++] * (vi - porous.v[w]).dot(xi - porous.x[w]); });
     return dt * rho0_2 * sum;
 }
 
@@ -72,8 +80,10 @@ struct SolveResult {
 };
 
 template <class Target>
-SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& p, const std::vector<Vec3>& base,
-                  BoundaryPressure boundary, std::vector<Vec3>& a_out, const Target& target, Real tolerance, int max_iterations) {
+SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& p,
+                  const std::vector<Vec3>& base, BoundaryPressure boundary,
+                  std::vector<Vec3>& a_out, const Target& target, Real tolerance,
+                  int max_iterations) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Index n = f.size();
@@ -83,18 +93,24 @@ SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& 
             a_out[i] = pressure_acceleration(model, state, p, i, boundary);
             s.v_pred[i] = base[i] + dt * a_out[i];
         });
-        parallel_for(n, [&](Index i) { s.rho_err[i] = f.rho[i] + density_change(model, state, s.v_pred, i, dt) - target(i); });
+        parallel_for(n, [&](Index i) {
+            s.rho_err[i] = f.rho[i] + density_change(model, state, s.v_pred, i, dt) - target(i);
+        });
         // The complementarity residual: compression where p_i = 0 is allowed to rise, and as much
         // over-pressure as p_i could give back where the fluid expands. A warm start that pushes
         // the fluid apart is thus corrected, not accepted because nothing is compressed.
-        r.max_error = parallel_max(n, 0.0, [&](Index i) {
-            const Real e = s.rho_err[i];
-            return e > 0 ? e : std::min(-e, s.diagonal[i] * p[i]);
-        }) / model.rho0;
+        r.max_error = parallel_max(n, 0.0,
+                                   [&](Index i) {
+                                       const Real e = s.rho_err[i];
+                                       return e > 0 ? e : std::min(-e, s.diagonal[i] * p[i]);
+                                   }) /
+                      model.rho0;
         ++r.iterations;
         if (r.max_error <= tolerance || r.iterations >= max_iterations) break;
         parallel_for(n, [&](Index i) {
-            if (s.diagonal[i] > 0) p[i] = std::max(p[i] + k_pressure_relaxation * s.rho_err[i] / s.diagonal[i], Real(0));
+            if (s.diagonal[i] > 0)
+                p[i] =
+                    std::max(p[i] + k_pressure_relaxation * s.rho_err[i] / s.diagonal[i], Real(0));
         });
     }
     return r;
@@ -116,8 +132,10 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     // 1. Divergence, from zero: fluid at or above rho0 may not compress further, lighter fluid up
     //    to rho0. Warm-started from the last step's p_div, a resting column kept moving.
     f.p_divergence.assign(n, 0);
-    const SolveResult div = relax(model, state, dt, f.p_divergence, f.v, BoundaryPressure::Mirrored, s.a_divergence,
-                                  [&](Index i) { return std::max(f.rho[i], rho0); }, fs.max_divergence_error, fs.max_iterations);
+    const SolveResult div = relax(
+        model, state, dt, f.p_divergence, f.v, BoundaryPressure::Mirrored, s.a_divergence,
+        [&](Index i) { return std::max(f.rho[i], rho0); }, fs.max_divergence_error,
+        fs.max_iterations);
     report.divergence_iterations = div.iterations;
 
     // 2. Constant density, with the non-pressure forces.
@@ -132,8 +150,9 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
         const bool compressed = f.rho[i] + density_change(model, state, base, i, dt) > rho0;
         f.p[i] = compressed ? 0.5 * f.p[i] : 0;
     });
-    const SolveResult density = relax(model, state, dt, f.p, base, BoundaryPressure::Hydrostatic, s.a_pressure,
-                                      [&](Index) { return rho0; }, fs.max_density_error, fs.max_iterations);
+    const SolveResult density = relax(
+        model, state, dt, f.p, base, BoundaryPressure::Hydrostatic, s.a_pressure,
+        [&](Index) { return rho0; }, fs.max_density_error, fs.max_iterations);
     report.iterations = density.iterations;
     report.max_density_error = density.max_error;
     parallel_for(n, [&](Index i) { s.a_pressure[i] += s.a_divergence[i]; });

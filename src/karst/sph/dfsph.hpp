@@ -7,7 +7,8 @@ namespace karst {
 struct PressureSolveReport {
     int iterations = 0;             ///< density-solve iterations (PCISPH: predictor-corrector)
     int divergence_iterations = 0;  ///< DFSPH divergence-solve iterations; 0 for PCISPH
-    Real max_density_error = 0;     ///< largest predicted compression max_i (rho*_i - rho0) / rho0 at the end
+    Real max_density_error =
+        0;  ///< largest predicted compression max_i (rho*_i - rho0) / rho0 at the end
 };
 
 /// Stage (method.md §4.3, replaced): divergence-free SPH after Bender & Koschier 2017, with the
@@ -19,8 +20,8 @@ struct PressureSolveReport {
 /// 2. constant density: v* = v + dt (a_div + a_other + a^p(p)), until rho*_i <= rho0 (1 + eta).
 /// The stopping test reads the complementarity residual (compression, or over-pressure that
 /// p_i could give back). The divergence solve starts from zero, the density solve from half the
-/// last step's pressure where the fluid would compress (dfsph.cpp says why). Writes state.fluid.p and p_divergence (Pa) and
-/// scratch.a_pressure = a_div + a^p(p) (m/s^2).
+/// last step's pressure where the fluid would compress (dfsph.cpp says why). Writes state.fluid.p
+/// and p_divergence (Pa) and scratch.a_pressure = a_div + a^p(p) (m/s^2).
 PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real dt);
 
 }  // namespace karst

@@ -34,7 +34,8 @@ bool push_back_through_walls(const Model& model, Vec3& x, Vec3& v) {
     bool pushed = false;
     for (const Wall& wall : model.scene.walls) {
         const Real d = wall.shape.signed_distance(x);
-        const Real outside = wall.kind == Wall::Kind::Container ? d : -d;  // > 0: on the wall's side
+        const Real outside =
+            wall.kind == Wall::Kind::Container ? d : -d;  // > 0: on the wall's side
         if (!(outside > 0)) continue;
         const Vec3 n = outward_normal(wall, x, 0.1 * model.dx);
         x -= (outside + k_push_back_depth * model.dx) * n;
@@ -71,10 +72,14 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
     return a_max;
 }
 
-void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged, Real dt_max) {
-    if (!converged) state.dt_solver_limit = 0.5 * dt;
-    else if (shortened) state.dt_solver_limit = dt;
-    else if (state.dt_solver_limit < dt_max) state.dt_solver_limit *= 1.1;
+void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged,
+                                   Real dt_max) {
+    if (!converged)
+        state.dt_solver_limit = 0.5 * dt;
+    else if (shortened)
+        state.dt_solver_limit = dt;
+    else if (state.dt_solver_limit < dt_max)
+        state.dt_solver_limit *= 1.1;
 }
 
 Real cfl_time_step(const Model& model, const State& state) {
@@ -82,8 +87,9 @@ Real cfl_time_step(const Model& model, const State& state) {
     if (t.fixed_dt) return *t.fixed_dt;
     const FluidParticles& f = state.fluid;
     const PorousParticles& p = state.porous.particles;
-    const Real v_max = std::sqrt(std::max(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }),
-                                          parallel_max(p.size(), 0.0, [&](Index i) { return p.v[i].squaredNorm(); })));
+    const Real v_max = std::sqrt(
+        std::max(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }),
+                 parallel_max(p.size(), 0.0, [&](Index i) { return p.v[i].squaredNorm(); })));
     Real dt = t.dt_max;
     if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
     if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));

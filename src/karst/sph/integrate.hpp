@@ -27,7 +27,8 @@ Real integrate_fluid(const Model& model, State& state, Real dt);
 /// motion compresses (about g dt^2 per layer, summed down a column) is what they must undo in
 /// their iterations; an unconverged solve leaves that compression, and the next impact throws it
 /// back out.
-void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged, Real dt_max);
+void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged,
+                                   Real dt_max);
 
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max)) clamped to [dt_min, dt_max], or the
 /// scene's fixed step. v_max is the largest fluid or porous speed now; a_max that of the last step;

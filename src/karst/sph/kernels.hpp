@@ -13,7 +13,9 @@ namespace karst {
 class CubicKernel {
 public:
     explicit CubicKernel(Real h)
-        : m_h(h), m_inv_h(1 / h), m_k(8 / (std::numbers::pi * h * h * h)),
+        : m_h(h),
+          m_inv_h(1 / h),
+          m_k(8 / (std::numbers::pi * h * h * h)),
           m_l(48 / (std::numbers::pi * h * h * h)) {}
 
     Real h() const { return m_h; }
@@ -69,7 +71,8 @@ inline Real cohesion_kernel(Real r, Real h) {
 inline Real adhesion_kernel(Real r, Real h) {
     if (r <= 0.5 * h || r > h) return 0;
     // The polynomial is zero at r = h; rounding can make it -1e-18 there, and pow would give NaN.
-    return 0.007 / std::pow(h, 3.25) * std::pow(std::max(-4 * r * r / h + 6 * r - 2 * h, Real(0)), 0.25);
+    return 0.007 / std::pow(h, 3.25) *
+           std::pow(std::max(-4 * r * r / h + 6 * r - 2 * h, Real(0)), 0.25);
 }
 
 }  // namespace karst

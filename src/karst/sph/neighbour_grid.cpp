@@ -24,7 +24,9 @@ UniformGrid::UniformGrid(const Aabb& box, Real cell_size) : origin(box.min), cel
         const double n = std::max(1.0, std::ceil((box.max[d] - box.min[d]) / cell_size));
         cells *= n;
         if (cells > k_max_cells)
-            throw SceneError("/domain", fmt::format("a domain of at most {:g} cells of size h = {:g} m", k_max_cells, cell_size),
+            throw SceneError("/domain",
+                             fmt::format("a domain of at most {:g} cells of size h = {:g} m",
+                                         k_max_cells, cell_size),
                              "a larger domain (shrink it or raise particle_spacing)");
         dims[d] = int(n);
     }
@@ -88,11 +90,13 @@ void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
             out.count[i] = std::uint16_t(std::min(k, cap));
             if (k > cap) {
                 int m = most.load();
-                while (k > m && !most.compare_exchange_weak(m, k)) {}
+                while (k > m && !most.compare_exchange_weak(m, k)) {
+                }
             }
         });
         if (most.load() == 0) return;
-        KARST_CHECK(most.load() < 65535, "a particle has {} neighbours: particles collapsed", most.load());
+        KARST_CHECK(most.load() < 65535, "a particle has {} neighbours: particles collapsed",
+                    most.load());
         out.capacity = most.load() + 16;  // grow and search again
     }
 }
@@ -114,7 +118,8 @@ std::vector<std::uint32_t> morton_order(const UniformGrid& grid, const std::vect
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(n);
     parallel_for(n, [&](Index i) {
         const auto c = grid.coords(x[i]);
-        keys[i] = {spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2, std::uint32_t(i)};
+        keys[i] = {spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2,
+                   std::uint32_t(i)};
     });
     std::sort(keys.begin(), keys.end());
     std::vector<std::uint32_t> perm(n);

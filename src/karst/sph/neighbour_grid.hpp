@@ -21,7 +21,9 @@ struct UniformGrid {
     UniformGrid(const Aabb& box, Real cell_size);
     Index cell_count() const { return Index(dims[0]) * dims[1] * dims[2]; }
     std::array<int, 3> coords(const Vec3& x) const;
-    Index linear(const std::array<int, 3>& c) const { return c[0] + Index(dims[0]) * (c[1] + Index(dims[1]) * c[2]); }
+    Index linear(const std::array<int, 3>& c) const {
+        return c[0] + Index(dims[0]) * (c[1] + Index(dims[1]) * c[2]);
+    }
     Index cell_of(const Vec3& x) const { return linear(coords(x)); }
 };
 

@@ -14,7 +14,9 @@ void compute_normals(const Model& model, State& state) {
     s.normal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         Vec3 n = Vec3::Zero();
-        s.fluid_fluid.for_each(i, [&](Index j) { n += (f.sph_mass[j] / f.rho[j]) * model.kernel.gradient(f.x[i] - f.x[j]); });
+        s.fluid_fluid.for_each(i, [&](Index j) {
+            n += (f.sph_mass[j] / f.rho[j]) * model.kernel.gradient(f.x[i] - f.x[j]);
+        });
         s.normal[i] = model.h * n;
     });
 }
@@ -47,13 +49,15 @@ void compute_non_pressure_forces(const Model& model, State& state) {
             const Vec3 grad = xij * W.dw_over_r(std::sqrt(r2));
             const Real vx = (vi - f.v[j]).dot(xij);
             a += (visc * f.sph_mass[j] * (1 / rho_i + 1 / f.rho[j]) * vx / (r2 + eps)) * grad;
-            if (vx < 0) a += (artificial / (rho_i + f.rho[j]) * f.sph_mass[j] * vx / (r2 + eps)) * grad;
+            if (vx < 0)
+                a += (artificial / (rho_i + f.rho[j]) * f.sph_mass[j] * vx / (r2 + eps)) * grad;
             if (tension) {
                 // Akinci 2013: K_ij (cohesion + curvature), per unit mass of i.
                 const Real r = std::sqrt(r2);
                 const Real k_ij = 2 * rho0 / (rho_i + f.rho[j]);
                 Vec3 fc = Vec3::Zero();
-                if (r > 1e-9 * h) fc = (-fs.surface_tension * f.sph_mass[j] * cohesion_kernel(r, h) / r) * xij;
+                if (r > 1e-9 * h)
+                    fc = (-fs.surface_tension * f.sph_mass[j] * cohesion_kernel(r, h) / r) * xij;
                 fc -= fs.surface_tension * (s.normal[i] - s.normal[j]);
                 a += k_ij * fc;
             }
@@ -62,10 +66,12 @@ void compute_non_pressure_forces(const Model& model, State& state) {
             // Friction and adhesion with walls (at rest) and porous particles (moving with their
             // fragment); the porous reactions are summed in coupling/fluid_reactions.cpp.
             s.fluid_wall.for_each(i, [&](Index k) {
-                a += boundary_shear_acceleration(shear, W, xi - model.walls.x[k], vi, rho_i, model.walls.psi[k]);
+                a += boundary_shear_acceleration(shear, W, xi - model.walls.x[k], vi, rho_i,
+                                                 model.walls.psi[k]);
             });
             s.fluid_porous.for_each(i, [&](Index k) {
-                a += boundary_shear_acceleration(shear, W, xi - porous.x[k], vi - porous.v[k], rho_i, psi[k]);
+                a += boundary_shear_acceleration(shear, W, xi - porous.x[k], vi - porous.v[k],
+                                                 rho_i, psi[k]);
             });
         }
         // Forces per unit rho0 V act on the true mass; gravity on every kilogram.

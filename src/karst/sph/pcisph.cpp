@@ -33,7 +33,8 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 
 /// Per-particle scaling factor delta_i (Pa per kg/m^3), M8 evaluated on the particle's own
 /// neighbourhood and capped at the prototype value:
-///   delta_i = rho0^2 / (2 dt^2 (|sum_j m_j grad W_ij + sum_k Psi_k grad W_ik|^2 + sum_j m_j^2 |grad W_ij|^2)).
+///   delta_i = rho0^2 / (2 dt^2 (|sum_j m_j grad W_ij + sum_k Psi_k grad W_ik|^2 + sum_j m_j^2
+///   |grad W_ij|^2)).
 /// Why [D]: M8's prototype (full fluid neighbourhood) omits the stiffness that Akinci wall
 /// neighbours add; at wall corners |sum_k Psi_k grad W_ik|^2 is several times the prototype's
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
@@ -56,10 +57,14 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
             sum_grad += g;
             sum_sq += g.squaredNorm();
         });
-        s.fluid_wall.for_each(i, [&](Index k) { sum_grad += model.walls.psi[k] * W.gradient(f.x[i] - model.walls.x[k]); });
-        s.fluid_porous.for_each(i, [&](Index k) { sum_grad += psi[k] * W.gradient(f.x[i] - porous.x[k]); });
+        s.fluid_wall.for_each(i, [&](Index k) {
+            sum_grad += model.walls.psi[k] * W.gradient(f.x[i] - model.walls.x[k]);
+        });
+        s.fluid_porous.for_each(
+            i, [&](Index k) { sum_grad += psi[k] * W.gradient(f.x[i] - porous.x[k]); });
         const Real denominator = sum_grad.squaredNorm() + sum_sq;
-        delta[i] = k_pressure_relaxation * (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
+        delta[i] = k_pressure_relaxation *
+                   (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
     });
 }
 
@@ -93,20 +98,27 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
         parallel_for(n, [&](Index i) {
             const Vec3 xi = s.x_pred[i];
             Real rho = f.sph_mass[i] * W.w0();
-            s.fluid_fluid.for_each(i, [&](Index j) { rho += f.sph_mass[j] * W.w((xi - s.x_pred[j]).norm()); });
-            s.fluid_wall.for_each(i, [&](Index k) { rho += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm()); });
-            s.fluid_porous.for_each(i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
+            s.fluid_fluid.for_each(
+                i, [&](Index j) { rho += f.sph_mass[j] * W.w((xi - s.x_pred[j]).norm()); });
+            s.fluid_wall.for_each(i, [&](Index k) {
+                rho += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm());
+            });
+            s.fluid_porous.for_each(
+                i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
             // Signed error, p clamped at 0 (method.md §4.3); the stopping test reads the
             // compression, or the over-pressure p_i could give back where the fluid expands.
             const Real e = rho - rho0;
             s.rho_err[i] = e > 0 ? e : std::min(-e, f.p[i] / s.delta[i]);
             f.p[i] = std::max(f.p[i] + s.delta[i] * e, Real(0));
         });
-        report.max_density_error = parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / rho0;
+        report.max_density_error =
+            parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / rho0;
         pressure_acceleration_and_prediction(model, state, dt);
         ++report.iterations;
         // Stopping rule (method.md §4.3; the paper's l.13 never ends).
-        if (report.iterations >= fs.min_iterations && report.max_density_error <= fs.max_density_error) break;
+        if (report.iterations >= fs.min_iterations &&
+            report.max_density_error <= fs.max_density_error)
+            break;
     }
     return report;
 }

@@ -12,7 +12,8 @@ void pressure_pair_coefficients(const Model& model, State& state) {
     const Vec3 rho0_g = model.rho0 * model.scene.gravity;
     const PorousParticles& porous = state.porous.particles;
     const std::vector<Real>& psi = state.porous_scratch.psi;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
+              cap_p = s.fluid_porous.capacity;
     s.pair_coefficient.resize(size_t(f.size()) * cap_f);
     s.wall_coefficient.resize(size_t(f.size()) * cap_w);
     s.wall_hydrostatic.resize(size_t(f.size()) * cap_w);
@@ -21,18 +22,21 @@ void pressure_pair_coefficients(const Model& model, State& state) {
     parallel_for(f.size(), [&](Index i) {
         int k = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
-            s.pair_coefficient[i * cap_f + k++] = f.sph_mass[j] * inv_rho0_2 * W.dw_over_r((f.x[i] - f.x[j]).norm());
+            s.pair_coefficient[i * cap_f + k++] =
+                f.sph_mass[j] * inv_rho0_2 * W.dw_over_r((f.x[i] - f.x[j]).norm());
         });
         k = 0;
         s.fluid_wall.for_each(i, [&](Index w) {
             const Vec3 xik = f.x[i] - model.walls.x[w];
-            s.wall_coefficient[i * cap_w + k] = boundary_pressure_coefficient(model.walls.psi[w], inv_rho0_2, W, xik);
+            s.wall_coefficient[i * cap_w + k] =
+                boundary_pressure_coefficient(model.walls.psi[w], inv_rho0_2, W, xik);
             s.wall_hydrostatic[i * cap_w + k++] = -rho0_g.dot(xik);
         });
         k = 0;
         s.fluid_porous.for_each(i, [&](Index w) {
             const Vec3 xik = f.x[i] - porous.x[w];
-            s.porous_coefficient[i * cap_p + k] = boundary_pressure_coefficient(psi[w], inv_rho0_2, W, xik);
+            s.porous_coefficient[i * cap_p + k] =
+                boundary_pressure_coefficient(psi[w], inv_rho0_2, W, xik);
             s.porous_hydrostatic[i * cap_p + k++] = -rho0_g.dot(xik);
         });
     });

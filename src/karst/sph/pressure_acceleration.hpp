@@ -28,11 +28,12 @@ enum class BoundaryPressure {
 
 /// a_i^p of fluid particle i for the pressures p (Pa), from the coefficients of this step; per
 /// unit rho0 V, scaled to act on the true mass. Boundary terms vanish where p_i = 0.
-inline Vec3 pressure_acceleration(const Model& model, const State& state, const std::vector<Real>& p, Index i,
-                                  BoundaryPressure boundary) {
+inline Vec3 pressure_acceleration(const Model& model, const State& state,
+                                  const std::vector<Real>& p, Index i, BoundaryPressure boundary) {
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity, cap_p = s.fluid_porous.capacity;
+    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
+              cap_p = s.fluid_porous.capacity;
     const Vec3 xi = f.x[i];
     const Real pi = p[i];
     Vec3 a = Vec3::Zero();

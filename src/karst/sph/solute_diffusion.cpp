@@ -32,8 +32,10 @@ void diffuse_solute(const Model& model, State& state, Real dt) {
                 const Real r2 = x.squaredNorm();
                 const Real x_grad_w = W.dw_over_r(std::sqrt(r2)) * r2;  // x.grad W = r dW/dr
                 const Real kappa_lo = f.rho[lo] * D, kappa_hi = f.rho[hi] * D;
-                const Real into_lo = f.mass[lo] * f.mass[hi] / (f.rho[lo] * f.rho[hi]) * (4 * kappa_lo * kappa_hi / (kappa_lo + kappa_hi)) *
-                                     (concentration[lo] - concentration[hi]) * x_grad_w / (r2 + eps);
+                const Real into_lo = f.mass[lo] * f.mass[hi] / (f.rho[lo] * f.rho[hi]) *
+                                     (4 * kappa_lo * kappa_hi / (kappa_lo + kappa_hi)) *
+                                     (concentration[lo] - concentration[hi]) * x_grad_w /
+                                     (r2 + eps);
                 sum += i == lo ? into_lo : -into_lo;
             });
             rate[i] = sum;
