@@ -185,7 +185,8 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         // 6-7. Fragments: contacts, rigid integration, members follow (§4.5).
         timed(profile, Stage::Fragments, [&] { advance_fragments(model, state, dt); });
         // 11a. Loads of the next Biot call (§5.3): this step's forces on the porous particles,
-        //      the fluid's reactions and now the contacts too, summed over the call's interval.
+        //      the fluid's reactions and the contacts, summed over the call's interval (here,
+        //      while the force array still matches the particles dissolution may remove).
         timed(profile, Stage::Structure, [&] { add_structure_loads(state, dt); });
         // 9. Dissolution into muddy fluid (§4.8); the fragments' mass properties follow the
         //    pore water and the members they lost.
@@ -203,7 +204,6 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             solve_structures(model, state);
             if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
         });
-        // (12. Topology after fracture: the next issue.)
     }
 
     state.time = t + dt;
