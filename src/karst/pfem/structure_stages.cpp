@@ -20,15 +20,14 @@ constexpr Real k_remesh_lost_fraction = 0.01;
 /// a remesh. Interior slivers that were under it at rest (tet_mesh.hpp) do not count.
 constexpr Real k_distorted_dihedral_deg = 2;
 
-/// Particle index of each porous particle id, -1 for ids no longer present.
+}  // namespace
+
 std::vector<Index> index_by_id(const PorousParticles& p, size_t ids) {
     std::vector<Index> index(ids, -1);
     for (Index i = 0; i < p.size(); ++i) index[p.id[i]] = i;
     return index;
 }
 
-/// The solver of structure `slot`, built (and its mobility brought to the last feedback) when
-/// the cache has none for the current mesh.
 BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     Structure& s = state.structures.structures[slot];
     if (BiotCache::Entry* e = state.biot_cache.find(slot, s.mesh_version)) return *e->solver;
@@ -50,6 +49,8 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
                      e.assembled_scale);
     return *e.solver;
 }
+
+namespace {
 
 /// Meshes structure `slot` on the rest positions of its fragment's present particles; u is
 /// carried per particle id, p starts at the drained pressure where drained and 0 elsewhere.
@@ -107,14 +108,11 @@ void build_structures(const Model& model, State& state) {
     const PorousParticles& p = state.porous.particles;
     size_t ids = 0;
     for (Index i = 0; i < p.size(); ++i) ids = std::max<size_t>(ids, size_t(p.id[i]) + 1);
-    st.impulse.assign(ids, Vec3::Zero()), st.u.assign(ids, Vec3::Zero()),
-        st.rest_tensor.assign(ids, Mat3::Zero());
-    st.rest_x.assign(ids, Vec3::Zero()), st.node_of.assign(ids, {-1, -1});
-    st.paired_scale.assign(ids, 1), st.paired_volume.assign(ids, 0);
+    st.grow_ids(ids);
     for (Index i = 0; i < p.size(); ++i) {
         const Index id = p.id[i];
         st.rest_tensor[id] = p.body_permeability[i], st.paired_volume[id] = p.volume[i],
-        st.rest_x[id] = p.x[i];
+        st.rest_volume[id] = p.volume[i], st.rest_x[id] = p.x[i];
     }
     if (model.coupled() && !model.scene.poroelastic.coupled_fragments) return;
     const std::vector<Fragment>& fragments = state.porous.fragments;
@@ -233,7 +231,6 @@ bool feed_back_structures(const Model& model, State& state) {
     StructureState& st = state.structures;
     PorousParticles& p = state.porous.particles;
     const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
-    const Real rest_volume = model.dx * model.dx * model.dx;
     bool stale = false;
     for (size_t slot = 0; slot < st.structures.size(); ++slot) {
         Structure& s = st.structures[slot];
@@ -247,7 +244,7 @@ bool feed_back_structures(const Model& model, State& state) {
             const Index i = index_of[s.node_id[a]];
             if (i < 0) continue;
             p.porosity[i] = pore.porosity[a];
-            p.volume[i] = rest_volume * (1 + stress.volumetric_strain[a]);
+            p.volume[i] = st.rest_volume[s.node_id[a]] * (1 + stress.volumetric_strain[a]);
             p.body_permeability[i] = pore.permeability_scale[a] * s.node_tensors[a];
             p.permeability[i] = R * p.body_permeability[i] * R.transpose();
             const Index id = s.node_id[a];

@@ -10,6 +10,13 @@
 
 namespace karst {
 
+/// Particle index of each porous particle id below `ids`, -1 for ids no longer present.
+std::vector<Index> index_by_id(const PorousParticles& p, size_t ids);
+
+/// The solver of structure `slot`, built (and its mobility brought to the last feedback) when
+/// the cache has none for the current mesh.
+BiotSolver& solver_of(const Model& model, State& state, size_t slot);
+
 /// Meshes every anchored fragment of a permeable solid on its particles' rest positions and
 /// builds its Biot problem (t = 0).
 void build_structures(const Model& model, State& state);

@@ -43,20 +43,46 @@ struct PfemTimings {
     bool all_converged = true;
 };
 
+/// A crack disk made by fracture (method.md §5.5), in world coordinates.
+struct CrackRecord {
+    Vec3 centre = Vec3::Zero(), normal = Vec3::UnitZ();  ///< m, unit
+    Real radius = 0, area = 0;                           ///< m, m^2 (M26, before the clamp)
+    Real time = 0;                                       ///< s
+    Index links_broken = 0;
+};
+
+/// What fracture did so far (stats.json "fracture").
+struct FractureCounts {
+    Index cracks = 0, links_broken = 0, nodes_split = 0, fragments_created = 0;
+    Real seconds = 0;  ///< the fracture phase (Table 3's "Fracture Process")
+};
+
 struct StructureState {
     std::vector<Structure> structures;
-    // Per porous particle id (PorousParticles::id):
+    // Per porous particle id (PorousParticles::id); grow_ids() sizes them for new ids:
     std::vector<Vec3> impulse;  ///< sum of force dt since the last call, N s
     std::vector<Vec3> u;        ///< displacement carried over a remesh, m
     std::vector<Vec3> rest_x;   ///< rest position X (world = body frame when anchored), m
     std::vector<std::pair<Index, Index>> node_of;  ///< (structure, node), or (-1, -1)
     std::vector<Mat3> rest_tensor;                 ///< K0 in the body frame, m^2
+    std::vector<Real> rest_volume;                 ///< V0, the bulk volume at eps_v = 0, m^3
     std::vector<Real> paired_scale,
-        paired_volume;  ///< k/k0 and V when the pore-flow pairs were built
-    Real elapsed = 0;   ///< time since the last call, s
+        paired_volume;          ///< k/k0 and V when the pore-flow pairs were built
+    std::vector<Index> damage;  ///< links broken on faces through the particle (§5.6)
+    Real elapsed = 0;           ///< time since the last call, s
     std::int64_t next_mesh_version = 0;
     PfemTimings timings;
+    FractureCounts fracture;
+    std::vector<CrackRecord> cracks;  ///< every crack so far, in the order made
     bool empty() const { return structures.empty(); }
+    /// Sizes the per-id arrays for ids below `ids` (new entries empty: no node, no load).
+    void grow_ids(size_t ids) {
+        if (ids <= u.size()) return;
+        impulse.resize(ids, Vec3::Zero()), u.resize(ids, Vec3::Zero()),
+            rest_x.resize(ids, Vec3::Zero()), node_of.resize(ids, {-1, -1});
+        rest_tensor.resize(ids, Mat3::Zero()), rest_volume.resize(ids, 0),
+            paired_scale.resize(ids, 1), paired_volume.resize(ids, 0), damage.resize(ids, 0);
+    }
 };
 
 /// Solvers of the structures' meshes. Copying a State copies no solver (the copy rebuilds

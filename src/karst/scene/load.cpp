@@ -128,7 +128,7 @@ Scene parse_scene(const std::string& text) {
         mat.darcy_viscosity = m["darcy_viscosity"];
         mat.solid_density = m["solid_density"], mat.youngs_modulus = m["youngs_modulus"];
         mat.poisson_ratio = m["poisson_ratio"], mat.biot_coefficient = m["biot_coefficient"];
-        mat.tensile_strength = m["tensile_strength"];
+        mat.tensile_strength = m["tensile_strength"], mat.fracture_energy = m["fracture_energy"];
         mat.capillary_pressure = m["capillary_pressure"],
         mat.capillary_exponent = m["capillary_exponent"];
         mat.pore_stiffness = m["pore_stiffness"],
@@ -199,6 +199,8 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.alpha = pe["alpha"], s.poroelastic.join_delta = pe["join_delta"];
     s.poroelastic.weighted_alpha = pe["weighted_alpha"];
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];
+    s.fracture.enabled = doc["fracture"]["enabled"],
+    s.fracture.max_cracks_per_call = doc["fracture"]["max_cracks_per_call"];
     s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"],
     s.output.ply = doc["output"]["ply"];
     s.max_speed = doc["watchdog"]["max_speed"];

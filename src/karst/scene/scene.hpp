@@ -62,6 +62,7 @@ struct PorousMaterial {
     Real poisson_ratio{};
     Real biot_coefficient{};     ///< B
     Real tensile_strength{};     ///< sigma_t, Pa
+    Real fracture_energy{};      ///< G_c (M26), J/m^2
     Real capillary_pressure{};   ///< k^c, Pa
     Real capillary_exponent{};   ///< alpha
     Real pore_stiffness{};       ///< k^p, Pa
@@ -122,6 +123,11 @@ struct PoroelasticSettings {
     bool weighted_alpha{};
 };
 
+struct FractureSettings {
+    bool enabled{};
+    int max_cracks_per_call{};  ///< N_crack
+};
+
 struct OutputSettings {
     Real fps{};
     bool vtp{};
@@ -139,6 +145,7 @@ struct Scene {
     std::vector<Wall> walls;
     std::vector<PorousSolid> porous_solids;
     PoroelasticSettings poroelastic;
+    FractureSettings fracture;
     bool paper_eq20{};  ///< /pore_flow/pair_flux: the paper's Eq. 20 instead of M15
     OutputSettings output;
     Real max_speed{};  ///< watchdog, m/s

@@ -171,7 +171,11 @@ std::vector<KeySpec> make_schema() {
         key("/porous_solids/[]/material/biot_coefficient", T::Number, "", closed(0.01, 1), 0.9,
             "Biot coefficient B = 1 - K_dr/K_s; it fixes the grain modulus K_s."),
         key("/porous_solids/[]/material/tensile_strength", T::Number, "Pa", positive(1e12), 1e5,
-            "Tensile strength sigma_t of the Rankine test (M25); output marks crack candidates."),
+            "Tensile strength sigma_t of the Rankine test (M25): a node whose largest effective "
+            "principal stress exceeds it cracks (with /fracture/enabled)."),
+        key("/porous_solids/[]/material/fracture_energy", T::Number, "J/m^2", positive(1e12), 10.0,
+            "Critical energy-release rate G_c (M26): a crack's area is the node's strain energy "
+            "over G_c (its radius clamped to 0.5-3 spacings)."),
         key("/porous_solids/[]/material/capillary_pressure", T::Number, "Pa", closed(0, 1e8),
             2000.0, "Capillary scale k^c of M4: the suction of dry material."),
         key("/porous_solids/[]/material/capillary_exponent", T::Number, "", closed(0.01, 1), 0.5,
@@ -302,6 +306,15 @@ std::vector<KeySpec> make_schema() {
         key("/poroelastic/weighted_alpha", T::Bool, "", any(), false,
             "Use the weighted alpha shape (regular triangulation) instead of the plain one."),
 
+        key("/fracture", T::Object, "", any(), json::object(),
+            "Fracture of the meshed solids (method.md §5.5-5.6): after every Biot call, Rankine "
+            "cracks on the effective stress break element links, split nodes, and pieces no longer "
+            "held by an anchor become free rigid fragments."),
+        key("/fracture/enabled", T::Bool, "", any(), true,
+            "false: the solids never crack (the stress is still written as crack_candidate)."),
+        key("/fracture/max_cracks_per_call", T::Integer, "", closed(1, 1000), 8,
+            "N_crack: most cracks per structure and Biot call, taken in decreasing "
+            "sigma'_1 / sigma_t; none within h of another crack of the same call."),
         key("/output", T::Object, "", any(), json::object(), "What is written, and how often."),
         key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0,
             "Frames per simulated second."),

@@ -9,6 +9,7 @@
 #include "karst/coupling/fluid_reactions.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
 #include "karst/coupling/porous_neighbours.hpp"
+#include "karst/pfem/fracture_stage.hpp"
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/porous/dissolution.hpp"
 #include "karst/porous/drained_fluid.hpp"
@@ -105,7 +106,7 @@ Real step_towards(Real dt_bound, Real now, Real target) {
 }  // namespace
 
 Real next_step_length(const Model& model, const State& state, Real target) {
-    if (model.poroelastic_only()) {
+    if (model.poroelastic_only() && !any_free_fragment(state)) {
         target = std::min(target, state.time + time_to_next_biot_call(model, state));
         return step_towards(model.scene.poroelastic.time_step, state.time, target);
     }
@@ -196,14 +197,24 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         });
         // 11. Algorithm 2 on the anchored fragments every dt_B (§5): the members move toward the
         //     last call's X + u (7, elastic part); when a call is due, remesh triggers (§4.10),
-        //     the Biot call on the mean loads (M22), and the feedback into the pores (§5.4).
-        timed(profile, Stage::Structure, [&] {
+        //     the Biot call on the mean loads (M22), fracture (§5.5-5.6: cracks, split nodes,
+        //     new free fragments) and the feedback into the pores (§5.4).
+        //     Fracture (§5.5-5.6) tests the call's stress before the feedback reads it.
+        const bool called = timed(profile, Stage::Structure, [&] {
             follow_structure_displacement(model, state);
-            if (!biot_call_due(model, state)) return;
+            if (!biot_call_due(model, state)) return false;
             remesh_structures(model, state);
             solve_structures(model, state);
-            if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
+            return true;
         });
+        if (called) {
+            if (timed(profile, Stage::Fracture,
+                      [&] { return fracture_structures(model, state, t + dt); }))
+                state.porous_scratch.pairs_stale = true;
+            timed(profile, Stage::Structure, [&] {
+                if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
+            });
+        }
     }
 
     state.time = t + dt;

@@ -17,13 +17,14 @@ enum class Stage {
     Fragments,
     Dissolution,
     Structure,
+    Fracture,
     Count
 };
 
 inline constexpr std::array<std::string_view, size_t(Stage::Count)> k_stage_names{
     "neighbours",     "density",         "solute_diffusion", "non_pressure_forces",
     "pressure_solve", "fluid_reactions", "pore_flow",        "integrate",
-    "fragments",      "dissolution",     "structure"};
+    "fragments",      "dissolution",     "structure",        "fracture"};
 
 struct StepProfile {
     std::array<double, size_t(Stage::Count)> seconds{};

@@ -1,0 +1,85 @@
+#include "karst/pfem/cracks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace karst {
+
+namespace {
+
+Vec3 centroid(const TetMesh& mesh, Index e) {
+    const Tet& t = mesh.tets[e];
+    return 0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]);
+}
+
+/// Centroid of the face two linked tets share: the mean of the nodes they have in common.
+Vec3 shared_face_centroid(const TetMesh& mesh, const ElementLink& link) {
+    const Tet& a = mesh.tets[link.a];
+    const Tet& b = mesh.tets[link.b];
+    Vec3 sum = Vec3::Zero();
+    int count = 0;
+    for (Index n : a)
+        if (std::find(b.begin(), b.end(), n) != b.end()) sum += mesh.nodes[n], ++count;
+    return sum / std::max(count, 1);
+}
+
+}  // namespace
+
+std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
+                               std::span<const Index> node_id, const CrackSettings& settings) {
+    std::vector<Crack> candidates;
+    for (Index a = 0; a < mesh.node_count(); ++a) {
+        const Real ratio = stress.principal[a][0] / settings.tensile_strength;
+        if (!(ratio > 1)) continue;
+        Crack c;
+        c.node = a, c.centre = mesh.nodes[a], c.stress_ratio = ratio;
+        // The eigenvector's sign is arbitrary: fix it so that the disk does not depend on the
+        // eigen solver's choice (its largest component positive).
+        Vec3 n = stress.principal_direction[a].normalized();
+        Index k;
+        n.cwiseAbs().maxCoeff(&k);
+        c.normal = n[k] < 0 ? Vec3(-n) : n;
+        c.area = std::max<Real>(stress.strain_energy[a], 0) / settings.fracture_energy;
+        c.radius = std::clamp(std::sqrt(c.area / std::numbers::pi), 0.5 * settings.spacing,
+                              3 * settings.spacing);
+        candidates.push_back(c);
+    }
+    std::sort(candidates.begin(), candidates.end(), [&](const Crack& x, const Crack& y) {
+        return x.stress_ratio != y.stress_ratio ? x.stress_ratio > y.stress_ratio
+                                                : node_id[x.node] < node_id[y.node];
+    });
+    std::vector<Crack> taken;
+    const Real min_distance2 = settings.exclusion * settings.exclusion;
+    for (const Crack& c : candidates) {
+        if (int(taken.size()) >= settings.max_cracks) break;
+        const bool near = std::any_of(taken.begin(), taken.end(), [&](const Crack& t) {
+            return (t.centre - c.centre).squaredNorm() < min_distance2;
+        });
+        if (!near) taken.push_back(c);
+    }
+    return taken;
+}
+
+std::vector<Index> links_cut(const TetMesh& mesh, std::span<const ElementLink> links,
+                             std::span<const Crack> cracks) {
+    std::vector<Index> cut(links.size(), -1);
+    if (cracks.empty()) return cut;
+    for (size_t k = 0; k < links.size(); ++k) {
+        const Vec3 ca = centroid(mesh, links[k].a), cb = centroid(mesh, links[k].b);
+        const Vec3 face = shared_face_centroid(mesh, links[k]);
+        for (size_t m = 0; m < cracks.size(); ++m) {
+            const Crack& c = cracks[m];
+            const Real sa = (ca - c.centre).dot(c.normal), sb = (cb - c.centre).dot(c.normal);
+            if (!((sa < 0 && sb > 0) || (sa > 0 && sb < 0))) continue;
+            const Vec3 r = face - c.centre;
+            if ((r - r.dot(c.normal) * c.normal).squaredNorm() < c.radius * c.radius) {
+                cut[k] = Index(m);
+                break;
+            }
+        }
+    }
+    return cut;
+}
+
+}  // namespace karst

@@ -1,0 +1,41 @@
+#pragma once
+// Where a structure cracks (method.md §5.5, M25-M26) and which element links a crack cuts
+// (§5.6): pure functions of the mesh and its nodal stresses, so they can be tested alone.
+#include "karst/pfem/nodal_stress.hpp"
+#include "karst/pfem/structure_state.hpp"
+
+#include <span>
+
+namespace karst {
+
+/// A crack disk in the mesh's frame (the rest positions).
+struct Crack {
+    Index node = 0;               ///< the mesh node it starts from
+    Vec3 centre = Vec3::Zero();   ///< m
+    Vec3 normal = Vec3::UnitZ();  ///< eigenvector of sigma'_1 (M25)
+    Real radius = 0;              ///< sqrt(area / pi), clamped to [0.5 dx, 3 dx] (M26), m
+    Real area = 0;                ///< U_a / G_c before the clamp (M26), m^2
+    Real stress_ratio = 0;        ///< sigma'_1 / sigma_t
+};
+
+struct CrackSettings {
+    Real tensile_strength = 1e5;  ///< sigma_t, Pa
+    Real fracture_energy = 10;    ///< G_c, J/m^2
+    Real spacing = 0.02;          ///< dx, m
+    Real exclusion = 0.04;        ///< no two cracks of one call closer than this (h), m
+    int max_cracks = 8;           ///< N_crack per call
+};
+
+/// M25: nodes whose largest effective principal stress exceeds sigma_t, in decreasing
+/// sigma'_1 / sigma_t (ties by the node's particle id, so the order of the particles does not
+/// matter), skipping nodes within `exclusion` of a crack already taken, at most `max_cracks`.
+std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
+                               std::span<const Index> node_id, const CrackSettings& settings);
+
+/// §5.6: per link, the first crack whose disk cuts the face the link stands for (-1: none): the
+/// two centroids lie on opposite sides of the crack plane and the shared face's centroid within
+/// the disk's radius of its axis.
+std::vector<Index> links_cut(const TetMesh& mesh, std::span<const ElementLink> links,
+                             std::span<const Crack> cracks);
+
+}  // namespace karst

@@ -1,0 +1,206 @@
+#include "karst/pfem/fracture_stage.hpp"
+
+#include "karst/core/timer.hpp"
+#include "karst/pfem/cracks.hpp"
+#include "karst/pfem/mesh_split.hpp"
+#include "karst/pfem/structure_stages.hpp"
+#include "karst/rigid/fragment_motion.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace karst {
+
+namespace {
+
+/// §5.6: copies sit this fraction of a spacing apart, so that a later Delaunay sees no
+/// coincident points.
+constexpr Real k_split_offset = 0.05;
+
+/// The shared face's nodes of a link.
+std::vector<Index> shared_nodes(const TetMesh& mesh, const ElementLink& l) {
+    std::vector<Index> nodes;
+    for (Index a : mesh.tets[l.a])
+        if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
+            nodes.push_back(a);
+    return nodes;
+}
+
+/// Appends a copy of particle i with id `id` (all attributes, then the id).
+void append_copy(PorousParticles& p, Index i, Index id) {
+    PorousParticles::for_each_attribute(
+        [&](auto& attribute) {
+            auto value = attribute[i];
+            attribute.push_back(value);
+        },
+        p);
+    p.id.back() = id;
+}
+
+/// A free rigid fragment of the members `members`: mass properties at rest orientation, and the
+/// linear and angular momentum the members carry, so that neither changes.
+Fragment free_fragment(PorousParticles& p, const std::vector<Index>& members, Real spacing) {
+    std::vector<Vec3> x, body;
+    std::vector<Real> mass;
+    for (Index i : members)
+        x.push_back(p.x[i]), mass.push_back(p.solid_mass[i] + p.absorbed_mass[i]);
+    Fragment f = fragment_at_rest(x, mass, body, spacing);
+    Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
+    for (size_t k = 0; k < members.size(); ++k) {
+        const Vec3& v = p.v[members[k]];
+        momentum += mass[k] * v, angular += mass[k] * body[k].cross(v);
+        p.rest[members[k]] = body[k];
+    }
+    f.velocity = momentum / f.mass, f.angular_momentum = angular;
+    f.anchored = false;
+    return f;
+}
+
+/// Cracks structure `slot`; returns true when its mesh changed.
+bool fracture_structure(const Model& model, State& state, size_t slot, Real time) {
+    StructureState& st = state.structures;
+    PorousParticles& p = state.porous.particles;
+    Structure& s = st.structures[slot];
+    const PorousMaterial& material = model.scene.porous_solids[s.solid].material;
+    const BiotProblem& problem = solver_of(model, state, slot).problem();
+    const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
+
+    NodalStress stress = nodal_stress(s.mesh, problem.material, s.fields);
+    for (Index a = 0; a < s.mesh.node_count(); ++a)  // a node whose particle is gone: no crack
+        if (index_of[s.node_id[a]] < 0)
+            stress.principal[a][0] = -std::numeric_limits<Real>::infinity();
+    const CrackSettings settings{material.tensile_strength, material.fracture_energy, model.dx,
+                                 model.h, model.scene.fracture.max_cracks_per_call};
+    std::vector<Crack> cracks = find_cracks(s.mesh, stress, s.node_id, settings);
+    if (cracks.empty()) return false;
+    const std::vector<Index> cutter = links_cut(s.mesh, s.links, cracks);
+    std::vector<Index> links_broken(cracks.size(), 0);
+    std::vector<char> cut(cutter.size(), 0);
+    for (size_t k = 0; k < cutter.size(); ++k)
+        if (cutter[k] >= 0) cut[k] = 1, ++links_broken[cutter[k]];
+    const Index broken = Index(std::count(cut.begin(), cut.end(), 1));
+    if (broken == 0) return false;
+
+    // Record the cracks that cut something, and the damage of the particles on broken faces.
+    for (size_t m = 0; m < cracks.size(); ++m) {
+        const Crack& c = cracks[m];
+        if (links_broken[m] == 0) continue;
+        st.cracks.push_back(
+            {c.centre + s.fields.u[c.node], c.normal, c.radius, c.area, time, links_broken[m]});
+        ++st.fracture.cracks;
+    }
+    st.fracture.links_broken += broken;
+    for (size_t k = 0; k < cut.size(); ++k)
+        if (cut[k])
+            for (Index a : shared_nodes(s.mesh, s.links[k])) ++st.damage[s.node_id[a]];
+
+    // M27: split the nodes, then carry the particles along.
+    const MeshSplit split = split_mesh(s.mesh, s.links, cut, k_split_offset * model.dx);
+    st.fracture.nodes_split += split.split_nodes;
+    const Index n_old = s.mesh.node_count(), n_new = split.mesh.node_count();
+    std::vector<Index> node_id(n_new);
+    std::copy(s.node_id.begin(), s.node_id.end(), node_id.begin());
+    for (Index k = n_old; k < n_new; ++k) node_id[k] = Index(state.next_id++);
+    st.grow_ids(size_t(state.next_id));
+    for (Index k = n_old; k < n_new; ++k) {
+        const Index parent = s.node_id[split.source[k]], i = index_of[parent];
+        if (i >= 0) append_copy(p, i, node_id[k]);
+        st.damage[node_id[k]] = st.damage[parent],
+        st.rest_tensor[node_id[k]] = st.rest_tensor[parent];
+        st.paired_scale[node_id[k]] = st.paired_scale[parent];
+        st.rest_volume[node_id[k]] = st.rest_volume[parent];
+        st.paired_volume[node_id[k]] = st.paired_volume[parent];
+    }
+    const std::vector<Index> particle = index_by_id(p, st.node_of.size());
+    for (Index k = 0; k < n_new; ++k) {
+        const Index id = node_id[k], a = split.source[k], i = particle[id];
+        const Vec3 move = split.mesh.nodes[k] - s.mesh.nodes[a];
+        const Real share = split.share[k];
+        st.rest_x[id] = split.mesh.nodes[k], st.u[id] = s.fields.u[a];
+        st.rest_volume[id] *= share, st.paired_volume[id] *= share;
+        if (i < 0) continue;
+        p.x[i] += move;
+        p.volume[i] *= share, p.absorbed_mass[i] *= share, p.solid_mass[i] *= share;
+    }
+
+    // Topology: components held by an anchor stay in the structure (with no anchor at all, the
+    // biggest one does); every other component becomes a free rigid fragment.
+    std::vector<char> anchored(split.components, 0);
+    std::vector<Index> tets_in(split.components, 0);
+    for (Index e = 0; e < split.mesh.tet_count(); ++e) {
+        ++tets_in[split.component[e]];
+        for (Index k : split.mesh.tets[e])
+            if (problem.fixed[split.source[k]]) anchored[split.component[e]] = 1;
+    }
+    if (std::none_of(anchored.begin(), anchored.end(), [](char c) { return c; }))
+        anchored[std::max_element(tets_in.begin(), tets_in.end()) - tets_in.begin()] = 1;
+    std::vector<char> keep(split.mesh.tet_count());
+    for (Index e = 0; e < split.mesh.tet_count(); ++e) keep[e] = anchored[split.component[e]];
+
+    std::vector<std::vector<Index>> members(split.components);
+    std::vector<char> placed(n_new, 0);
+    for (Index e = 0; e < split.mesh.tet_count(); ++e) {
+        if (keep[e]) continue;
+        for (Index k : split.mesh.tets[e])
+            if (!placed[k] && particle[node_id[k]] >= 0)
+                placed[k] = 1, members[split.component[e]].push_back(particle[node_id[k]]);
+    }
+    for (Index c = 0; c < split.components; ++c) {
+        if (anchored[c] || members[c].empty()) continue;
+        const Index f = Index(state.porous.fragments.size());
+        for (Index i : members[c]) p.fragment[i] = f;
+        state.porous.fragments.push_back(free_fragment(p, members[c], model.dx));
+        ++st.fracture.fragments_created;
+    }
+
+    // The structure keeps the anchored components, on their nodes (and the loose ones).
+    std::vector<Index> node_of, tet_of;
+    TetMesh mesh = sub_mesh(split.mesh, keep, true, node_of, tet_of);
+    for (Index k = 0; k < n_new; ++k) st.node_of[node_id[k]] = {-1, -1};
+    Structure next;
+    next.fragment = s.fragment, next.solid = s.solid;
+    next.mesh_version = st.next_mesh_version++;
+    const Index n = mesh.node_count();
+    next.node_id.resize(n), next.fields.u.resize(n), next.fields.p.resize(n), next.u_from.resize(n);
+    next.node_tensors.resize(n), next.permeability_scale.resize(n);
+    for (Index a = 0; a < n; ++a) {
+        const Index k = node_of[a], from = split.source[k];
+        next.node_id[a] = node_id[k];
+        next.fields.u[a] = s.fields.u[from], next.fields.p[a] = s.fields.p[from];
+        next.u_from[a] = s.u_from[from], next.node_tensors[a] = s.node_tensors[from];
+        next.permeability_scale[a] = s.permeability_scale[from];
+        st.node_of[node_id[k]] = {Index(slot), a};
+    }
+    std::vector<Index> new_tet(split.mesh.tet_count(), -1);
+    for (size_t e = 0; e < tet_of.size(); ++e) new_tet[tet_of[e]] = Index(e);
+    for (const ElementLink& l : split.links)
+        if (new_tet[l.a] >= 0 && new_tet[l.b] >= 0)
+            next.links.push_back(
+                {std::min(new_tet[l.a], new_tet[l.b]), std::max(new_tet[l.a], new_tet[l.b])});
+    next.well_shaped.resize(tet_of.size());
+    for (size_t e = 0; e < tet_of.size(); ++e) next.well_shaped[e] = s.well_shaped[tet_of[e]];
+    next.mesh = std::move(mesh);
+    s = std::move(next);
+    return true;
+}
+
+}  // namespace
+
+bool fracture_structures(const Model& model, State& state, Real time) {
+    if (!model.scene.fracture.enabled) return false;
+    Stopwatch watch;
+    bool changed = false;
+    const size_t count = state.structures.structures.size();
+    for (size_t slot = 0; slot < count; ++slot)
+        changed = fracture_structure(model, state, slot, time) || changed;
+    if (changed) refresh_fragment_mass(state, model.dx);
+    state.structures.fracture.seconds += watch.seconds();
+    return changed;
+}
+
+bool any_free_fragment(const State& state) {
+    return std::any_of(state.porous.fragments.begin(), state.porous.fragments.end(),
+                       [](const Fragment& f) { return !f.anchored && f.mass > 0; });
+}
+
+}  // namespace karst

@@ -1,0 +1,18 @@
+#pragma once
+// Algorithm 2 l.8-21 on State (method.md §5.5-5.6): after a Biot call, every structure is
+// tested for Rankine cracks (M25-M26); the links they cut break, nodes whose elements fall apart
+// split into new porous particles (M27), and the pieces no longer held by an anchor become free
+// rigid fragments. Mass, pore water and the linear and angular momentum are kept exactly.
+#include "karst/sim/model.hpp"
+#include "karst/sim/state.hpp"
+
+namespace karst {
+
+/// Cracks made at `time` are recorded with it. Returns true when some structure changed (new
+/// particles or fragments): the pore-flow pairs are then stale.
+bool fracture_structures(const Model& model, State& state, Real time);
+
+/// Whether some fragment moves (free, with mass): a poroelastic-only run then needs the CFL step.
+bool any_free_fragment(const State& state);
+
+}  // namespace karst

@@ -1,0 +1,193 @@
+#include "karst/pfem/mesh_split.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace karst {
+
+namespace {
+
+/// Union-find over [0, n) with path halving; the root of a set is its smallest member.
+struct DisjointSets {
+    std::vector<Index> parent;
+    explicit DisjointSets(Index n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+    Index find(Index x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    }
+    void join(Index a, Index b) {
+        a = find(a), b = find(b);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+};
+
+/// Renumbers ids 0, 1, ... in order of first appearance.
+void compact_ids(std::vector<Index>& ids) {
+    std::vector<Index> number;
+    Index next = 0;
+    for (Index& id : ids) {
+        if (id >= Index(number.size())) number.resize(id + 1, -1);
+        if (number[id] < 0) number[id] = next++;
+        id = number[id];
+    }
+}
+
+/// Recomputes the EDT groups (M20) so that no group spans a broken link.
+std::vector<Index> regroup_polyhedra(const TetMesh& mesh, std::span<const ElementLink> unbroken) {
+    DisjointSets sets(mesh.tet_count());
+    for (const ElementLink& l : unbroken)
+        if (mesh.tet_polyhedron[l.a] == mesh.tet_polyhedron[l.b]) sets.join(l.a, l.b);
+    std::vector<Index> group(mesh.tet_count());
+    for (Index e = 0; e < mesh.tet_count(); ++e) group[e] = sets.find(e);
+    compact_ids(group);
+    return group;
+}
+
+}  // namespace
+
+std::vector<Triangle> boundary_faces(std::span<const Tet> tets) {
+    // Outward faces of a positively oriented tet (a, b, c, d), opposite a, b, c, d.
+    constexpr int k_face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    struct Face {
+        std::array<Index, 3> key;
+        Triangle oriented;
+    };
+    std::vector<Face> faces;
+    faces.reserve(4 * tets.size());
+    for (const Tet& t : tets)
+        for (const auto& f : k_face) {
+            Face face{{t[f[0]], t[f[1]], t[f[2]]}, {t[f[0]], t[f[1]], t[f[2]]}};
+            std::sort(face.key.begin(), face.key.end());
+            faces.push_back(face);
+        }
+    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
+        return a.key != b.key ? a.key < b.key : a.oriented < b.oriented;
+    });
+    std::vector<Triangle> boundary;
+    for (size_t k = 0; k < faces.size();) {
+        size_t end = k + 1;
+        while (end < faces.size() && faces[end].key == faces[k].key) ++end;
+        if (end == k + 1) boundary.push_back(faces[k].oriented);
+        k = end;
+    }
+    return boundary;
+}
+
+MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
+                     std::span<const char> broken, Real offset) {
+    const Index n = mesh.node_count(), ne = mesh.tet_count();
+    MeshSplit out;
+    for (size_t k = 0; k < links.size(); ++k)
+        if (!broken[k]) out.links.push_back(links[k]);
+
+    // The tets around every node (CSR), and the groups among them over unbroken links.
+    std::vector<Index> start(n + 1, 0);
+    for (const Tet& t : mesh.tets)
+        for (Index a : t) ++start[a + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<Index> around(start[n]);
+    {
+        std::vector<Index> fill(start.begin(), start.end() - 1);
+        for (Index e = 0; e < ne; ++e)
+            for (Index a : mesh.tets[e]) around[fill[a]++] = e;
+    }
+    // Local union-find: slot of tet e around node a; the sets live on the CSR slots.
+    DisjointSets slots(start[n]);
+    auto slot_of = [&](Index a, Index e) {
+        return Index(std::lower_bound(around.begin() + start[a], around.begin() + start[a + 1], e) -
+                     around.begin());
+    };
+    for (const ElementLink& l : out.links)
+        for (Index a : mesh.tets[l.a])
+            if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
+                slots.join(slot_of(a, l.a), slot_of(a, l.b));
+
+    out.mesh = mesh;
+    out.source.resize(n);
+    std::iota(out.source.begin(), out.source.end(), 0);
+    out.share.assign(n, 1);
+    std::vector<Vec3> moves;
+    for (Index a = 0; a < n; ++a) {
+        // Groups in order of their lowest tet: the first keeps the node's index.
+        std::vector<Index> roots;
+        for (Index s = start[a]; s < start[a + 1]; ++s)
+            if (slots.find(s) == s) roots.push_back(s);
+        if (roots.size() < 2) continue;
+        ++out.split_nodes;
+        std::vector<Real> volume(roots.size(), 0);
+        std::vector<Vec3> side(roots.size(), Vec3::Zero());
+        std::vector<Index> copy(roots.size());
+        for (size_t g = 0; g < roots.size(); ++g) {
+            copy[g] = g == 0 ? a : Index(out.source.size());
+            if (g > 0) {
+                out.source.push_back(a), out.share.push_back(1);
+                out.mesh.nodes.push_back(mesh.nodes[a]);
+            }
+        }
+        for (Index s = start[a]; s < start[a + 1]; ++s) {
+            const size_t g = std::find(roots.begin(), roots.end(), slots.find(s)) - roots.begin();
+            const Index e = around[s];
+            const Real v = mesh.tet_volume(e) / 4;
+            const Tet& t = mesh.tets[e];
+            volume[g] += v;
+            side[g] += v * (0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] +
+                                    mesh.nodes[t[3]]) -
+                            mesh.nodes[a]);
+            for (Index& node : out.mesh.tets[e])
+                if (node == a) node = copy[g];
+        }
+        const Real total = std::accumulate(volume.begin(), volume.end(), Real(0));
+        Vec3 mean = Vec3::Zero();
+        moves.assign(roots.size(), Vec3::Zero());
+        for (size_t g = 0; g < roots.size(); ++g) {
+            out.share[copy[g]] = volume[g] / total;
+            if (side[g].norm() > 0) moves[g] = offset * side[g].normalized();
+            mean += out.share[copy[g]] * moves[g];
+        }
+        for (size_t g = 0; g < roots.size(); ++g) out.mesh.nodes[copy[g]] += moves[g] - mean;
+    }
+
+    out.mesh.boundary = boundary_faces(out.mesh.tets);
+    if (!out.mesh.tet_polyhedron.empty())
+        out.mesh.tet_polyhedron = regroup_polyhedra(mesh, out.links);
+    DisjointSets parts(ne);
+    for (const ElementLink& l : out.links) parts.join(l.a, l.b);
+    out.component.resize(ne);
+    std::vector<Index> number(ne, -1);
+    for (Index e = 0; e < ne; ++e) {
+        const Index root = parts.find(e);
+        if (number[root] < 0) number[root] = out.components++;
+        out.component[e] = number[root];
+    }
+    return out;
+}
+
+TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loose_nodes,
+                 std::vector<Index>& node_of, std::vector<Index>& tet_of) {
+    std::vector<Index> new_index(mesh.node_count(), keep_loose_nodes ? 0 : -1);
+    for (const Tet& t : mesh.tets)
+        for (Index a : t) new_index[a] = -1;
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        if (keep[e])
+            for (Index a : mesh.tets[e]) new_index[a] = 0;
+    TetMesh out;
+    out.quality = mesh.quality;
+    node_of.clear(), tet_of.clear();
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        if (new_index[a] == 0)
+            new_index[a] = Index(node_of.size()), node_of.push_back(a),
+            out.nodes.push_back(mesh.nodes[a]);
+    for (Index e = 0; e < mesh.tet_count(); ++e) {
+        if (!keep[e]) continue;
+        const Tet& t = mesh.tets[e];
+        out.tets.push_back({new_index[t[0]], new_index[t[1]], new_index[t[2]], new_index[t[3]]});
+        if (!mesh.tet_polyhedron.empty()) out.tet_polyhedron.push_back(mesh.tet_polyhedron[e]);
+        tet_of.push_back(e);
+    }
+    compact_ids(out.tet_polyhedron);
+    out.boundary = boundary_faces(out.tets);
+    out.quality.elements = out.tet_count();
+    return out;
+}
+
+}  // namespace karst

@@ -1,0 +1,38 @@
+#pragma once
+// Node splitting along broken links (method.md §5.6, M27) and the extraction of a mesh's
+// components, on the mesh alone: the caller carries the particles (mass, water, momentum) along
+// with the `source` and `share` arrays.
+#include "karst/pfem/structure_state.hpp"
+
+#include <span>
+
+namespace karst {
+
+struct MeshSplit {
+    TetMesh mesh;                    ///< the input's tets on split nodes, copies appended
+    std::vector<Index> source;       ///< per node: the input node it is (a copy of)
+    std::vector<Real> share;         ///< per node: its part of the source's volume, 1 if whole
+    std::vector<ElementLink> links;  ///< the unbroken links (tet indices unchanged)
+    std::vector<Index> component;    ///< per tet: connected component over unbroken links
+    Index components = 0;            ///< numbered in order of their lowest tet
+    Index split_nodes = 0;           ///< input nodes that were duplicated
+};
+
+/// M27: around every node, its tets are grouped by the unbroken links among them; a node with k
+/// groups becomes k nodes, one per group, sharing the node by the groups' volumes
+/// (sum V_e / 4). Each copy moves `offset` towards its group's side, and the moves are shifted
+/// so that their share-weighted sum is zero: mass-weighted positions, hence the linear and
+/// angular momentum of copies given the source's velocity, are kept.
+MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
+                     std::span<const char> broken, Real offset);
+
+/// The tets with keep[e] set, on their nodes (renumbered in input order), and with
+/// `keep_loose_nodes` the nodes that belong to no tet: `node_of` gets, per node of the result,
+/// its index in `mesh`, and `tet_of` per tet.
+TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loose_nodes,
+                 std::vector<Index>& node_of, std::vector<Index>& tet_of);
+
+/// The faces that belong to one tet only, oriented outward.
+std::vector<Triangle> boundary_faces(std::span<const Tet> tets);
+
+}  // namespace karst

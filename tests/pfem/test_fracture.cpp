@@ -1,0 +1,205 @@
+// Fracture (issue 13, method.md §5.5-5.6): the Rankine test on the effective stress of solved
+// Biot problems (tension, shear, compression, pore pressure alone), and node splitting along
+// broken links.
+#include "karst/pfem/box_nodes.hpp"
+#include "karst/pfem/cracks.hpp"
+#include "karst/pfem/face_links.hpp"
+#include "karst/pfem/mesh_split.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <numbers>
+
+namespace karst {
+namespace {
+
+constexpr Real k_strength = 1e5, k_dx = 0.1;
+
+/// A box sample [0, size] on a lattice of spacing k_dx, turned by `turn` about the origin,
+/// solved as a free, drained Biot body with pore pressure `p` and the tractions of `stress`
+/// (given in the box's own frame) on its six faces.
+struct Sample {
+    TetMesh mesh;
+    BiotProblem problem;
+    BiotFields fields;
+    NodalStress stress;
+
+    Sample(const Vec3& size, const Mat3& turn, const Mat3& stress_local, Real p = 0) {
+        // Meshed in the box's frame, then turned: the same mesh in any orientation.
+        const std::vector<Vec3> nodes = box_lattice_nodes(Vec3::Zero(), size, k_dx);
+        mesh = build_tet_mesh(nodes, std::vector<Real>(nodes.size(), k_dx), MeshOptions{});
+        for (Vec3& x : mesh.nodes) x = turn * x;
+        BiotMaterial& m = problem.material;
+        m.youngs_modulus = 1e6, m.poisson_ratio = 0.25, m.biot_coefficient = 0.9;
+        m.storage = 1e-6, m.bulk_density = 0;
+        const Index n = mesh.node_count();
+        problem.mobility.assign(mesh.tet_count(), 1e-9 * Mat3::Identity());
+        problem.drained.assign(n, 1), problem.drained_pressure.assign(n, p);
+        problem.fixed.assign(n, 0), problem.free_body = true;
+        problem.nodal_force.assign(n, Vec3::Zero());
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                const Vec3 normal = (side ? 1.0 : -1.0) * Vec3::Unit(axis);
+                const Vec3 traction = turn * (stress_local * normal);
+                const auto on_face = [&](const Vec3& x) {
+                    const Real local = (turn.transpose() * x)[axis];
+                    return std::abs(local - (side ? size[axis] : 0)) < 1e-9;
+                };
+                const auto loads = traction_loads(mesh, traction, on_face);
+                for (Index a = 0; a < n; ++a) problem.nodal_force[a] += loads[a];
+            }
+        BiotSolver solver(mesh, problem);
+        fields = {std::vector<Vec3>(n, Vec3::Zero()), std::vector<Real>(n, p)};
+        solver.advance(1.0, fields);
+        stress = nodal_stress(mesh, problem.material, fields);
+    }
+
+    std::vector<Crack> cracks() const {
+        std::vector<Index> ids(mesh.node_count());
+        for (Index a = 0; a < mesh.node_count(); ++a) ids[a] = a;
+        const CrackSettings settings{k_strength, 10, k_dx, 2 * k_dx, 8};
+        return find_cracks(mesh, stress, ids, settings);
+    }
+};
+
+Mat3 uniaxial(Real s) {
+    return s * Vec3::UnitX() * Vec3::UnitX().transpose();
+}
+
+Mat3 turned_30_about_two_axes() {
+    const Real a = std::numbers::pi / 6;
+    return (Eigen::AngleAxisd(a, Vec3::UnitZ()) * Eigen::AngleAxisd(a, Vec3::UnitY()))
+        .toRotationMatrix();
+}
+
+Real angle_deg(const Vec3& a, const Vec3& b) {
+    return std::acos(std::min<Real>(1, std::abs(a.normalized().dot(b.normalized())))) * 180 /
+           std::numbers::pi;
+}
+
+TEST(Cracks, BarInTensionCracksBetween95And105PercentOfTheStrengthNormalToTheLoad) {
+    const Vec3 size(1.2, 0.3, 0.3);
+    for (const Mat3& turn : {Mat3(Mat3::Identity()), turned_30_about_two_axes()}) {
+        EXPECT_TRUE(Sample(size, turn, uniaxial(0.95 * k_strength)).cracks().empty());
+        const std::vector<Crack> cracks = Sample(size, turn, uniaxial(1.05 * k_strength)).cracks();
+        ASSERT_FALSE(cracks.empty());
+        EXPECT_LE(cracks.size(), 8u);
+        for (const Crack& c : cracks) {
+            EXPECT_LT(angle_deg(c.normal, turn * Vec3::UnitX()), 5);
+            EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
+        }
+        // None of one call within h of another.
+        for (size_t i = 0; i < cracks.size(); ++i)
+            for (size_t j = 0; j < i; ++j)
+                EXPECT_GE((cracks[i].centre - cracks[j].centre).norm(), 2 * k_dx);
+    }
+}
+
+TEST(Cracks, PureShearCracksAt45DegreesToTheShearAxes) {
+    Mat3 shear = Mat3::Zero();
+    shear(0, 1) = shear(1, 0) = 1.1 * k_strength;
+    const std::vector<Crack> cracks = Sample(Vec3(0.6, 0.6, 0.3), Mat3::Identity(), shear).cracks();
+    ASSERT_FALSE(cracks.empty());
+    for (const Crack& c : cracks) EXPECT_LT(angle_deg(c.normal, Vec3(1, 1, 0)), 5);
+    shear *= 0.95 / 1.1;
+    EXPECT_TRUE(Sample(Vec3(0.6, 0.6, 0.3), Mat3::Identity(), shear).cracks().empty());
+}
+
+TEST(Cracks, HydrostaticCompressionNeverCracks) {
+    const Sample s(Vec3(0.6, 0.4, 0.5), Mat3::Identity(), -100 * k_strength * Mat3::Identity());
+    EXPECT_LT(s.stress.principal[0][0], -99 * k_strength);
+    EXPECT_TRUE(s.cracks().empty());
+}
+
+TEST(Cracks, PorePressureAloneCracksWhenBTimesPReachesTheStrength) {
+    // No load: the total stress stays zero, so sigma' = B p I (Terzaghi-Biot) turns tensile.
+    const Real B = 0.9, p_crack = k_strength / B;
+    const Vec3 size(0.5, 0.4, 0.3);
+    EXPECT_TRUE(Sample(size, Mat3::Identity(), Mat3::Zero(), 0.95 * p_crack).cracks().empty());
+    const Sample wet(size, Mat3::Identity(), Mat3::Zero(), 1.05 * p_crack);
+    EXPECT_FALSE(wet.cracks().empty());
+    for (Index a = 0; a < wet.mesh.node_count(); ++a)
+        ASSERT_NEAR(wet.stress.principal[a][0] / (B * 1.05 * p_crack), 1, 0.01) << "node " << a;
+}
+
+TEST(Cracks, CrackRadiusComesFromTheStrainEnergyOverGc) {
+    const Sample s(Vec3(1.2, 0.3, 0.3), Mat3::Identity(), uniaxial(2 * k_strength));
+    std::vector<Index> ids(s.mesh.node_count());
+    for (Index a = 0; a < s.mesh.node_count(); ++a) ids[a] = a;
+    for (Real Gc : {1e-4, 1.0, 1e4}) {
+        const auto cracks = find_cracks(s.mesh, s.stress, ids, {k_strength, Gc, k_dx, 0.2, 8});
+        ASSERT_FALSE(cracks.empty());
+        const Crack& c = cracks[0];
+        EXPECT_NEAR(c.area, s.stress.strain_energy[c.node] / Gc, 1e-12 * c.area);
+        EXPECT_NEAR(c.radius,
+                    std::clamp(std::sqrt(c.area / std::numbers::pi), 0.5 * k_dx, 3 * k_dx), 1e-15);
+    }
+}
+
+TEST(MeshSplit, ACutThroughABarSplitsItsNodesAndSharesTheirVolume) {
+    const Vec3 size(1.0, 0.3, 0.3);
+    std::vector<Vec3> nodes = box_lattice_nodes(Vec3::Zero(), size, k_dx);
+    const TetMesh mesh =
+        build_tet_mesh(nodes, std::vector<Real>(nodes.size(), k_dx), MeshOptions{});
+    const std::vector<ElementLink> links = face_links(mesh);
+    // A crack disk at x = 0.5 across the whole section (the plane runs through a lattice layer:
+    // every tet lies on one side of it).
+    Crack c;
+    c.centre = Vec3(0.5, 0.15, 0.15), c.normal = Vec3::UnitX(), c.radius = 0.5;
+    const std::vector<Index> cutter = links_cut(mesh, links, std::span(&c, 1));
+    std::vector<char> broken(links.size());
+    for (size_t k = 0; k < links.size(); ++k) broken[k] = cutter[k] >= 0;
+    const MeshSplit split = split_mesh(mesh, links, broken, 0.05 * k_dx);
+    EXPECT_EQ(split.components, 2);
+    EXPECT_EQ(split.split_nodes, 4 * 4);  // the 4 x 4 nodes of the layer x = 0.5
+    ASSERT_EQ(split.mesh.node_count(), mesh.node_count() + 16);
+    // Shares of each source sum to one; share-weighted positions are unchanged.
+    std::vector<Real> total(mesh.node_count(), 0);
+    std::vector<Vec3> moment(mesh.node_count(), Vec3::Zero());
+    for (Index k = 0; k < split.mesh.node_count(); ++k) {
+        total[split.source[k]] += split.share[k];
+        moment[split.source[k]] += split.share[k] * split.mesh.nodes[k];
+    }
+    for (Index a = 0; a < mesh.node_count(); ++a) {
+        ASSERT_NEAR(total[a], 1, 1e-14);
+        ASSERT_LT((moment[a] - mesh.nodes[a]).norm(), 1e-15);
+    }
+    // Each split node's copies move apart, each to its own side of the cut.
+    std::vector<Index> component_of_node(split.mesh.node_count(), -1);
+    for (Index e = 0; e < split.mesh.tet_count(); ++e)
+        for (Index k : split.mesh.tets[e]) {
+            if (component_of_node[k] >= 0) {  // no tet of one component uses the other's nodes
+                ASSERT_EQ(component_of_node[k], split.component[e]);
+            }
+            component_of_node[k] = split.component[e];
+        }
+    for (Index k = mesh.node_count(); k < split.mesh.node_count(); ++k) {
+        const Index a = split.source[k];
+        EXPECT_GT((split.mesh.nodes[k] - split.mesh.nodes[a]).norm(), 0.05 * k_dx);
+        const Real side_k = split.mesh.nodes[k][0] - 0.5, side_a = split.mesh.nodes[a][0] - 0.5;
+        EXPECT_LT(side_k * side_a, 0);
+        EXPECT_NEAR(split.share[a] + split.share[k], 1, 1e-14);
+    }
+    // Unmoved, the boundary closes each half: it gains the two crack faces (2 x 0.3 x 0.3).
+    const MeshSplit unmoved = split_mesh(mesh, links, broken, 0);
+    Real area = 0, area_before = 0;
+    for (const Triangle& t : unmoved.mesh.boundary) area += unmoved.mesh.area_vector(t).norm();
+    for (const Triangle& t : mesh.boundary) area_before += mesh.area_vector(t).norm();
+    EXPECT_NEAR(area - area_before, 2 * 0.09, 1e-9);
+    // The half beyond the cut, as a mesh of its own, is closed with the bar's other half's area.
+    std::vector<char> keep(unmoved.mesh.tet_count());
+    for (Index e = 0; e < unmoved.mesh.tet_count(); ++e) keep[e] = unmoved.component[e] == 1;
+    std::vector<Index> node_of, tet_of;
+    const TetMesh half = sub_mesh(unmoved.mesh, keep, false, node_of, tet_of);
+    Real enclosed = 0;
+    for (const Triangle& t : half.boundary)
+        enclosed += half.nodes[t[0]].dot(half.area_vector(t)) / 3;
+    EXPECT_NEAR(enclosed, 0.5 * 0.09, 1e-12);
+    EXPECT_EQ(half.node_count(), 6 * 4 * 4);
+}
+
+}  // namespace
+}  // namespace karst
