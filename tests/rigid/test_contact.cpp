@@ -15,7 +15,7 @@ struct Collision {
     Collision(Real gap, Real v0, Index second_fragment) {
         p.x = {Vec3(0, 0, 0), Vec3(gap, 0, 0)};
         p.v = {Vec3(v0, 0, 0), Vec3(-v0, 0, 0)};
-        p.fragment = {0, second_fragment};
+        p.fragment = {0, second_fragment}, p.origin = {0, 1};
         p.volume = p.porosity = p.absorbed_mass = p.solid_mass = {0, 0};
         p.permeability = {Mat3::Zero(), Mat3::Zero()};
         pairs.capacity = 1, pairs.index = {1, 0}, pairs.count = {1, 1};

@@ -1,5 +1,7 @@
 #include "karst/pfem/biot_setup.hpp"
 
+#include "karst/pfem/rigid_modes.hpp"
+
 #include "karst/core/timer.hpp"
 #include "karst/pfem/porosity.hpp"
 
@@ -96,8 +98,9 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
             if (w.kind == Wall::Kind::Obstacle ? d <= model.dx : d >= -model.dx)
                 p.fixed[a] = FixAll;
         }
-    p.free_body =
-        std::all_of(p.fixed.begin(), p.fixed.end(), [](std::uint8_t f) { return f == 0; });
+    // Without anchors, or anchored only at a point or along a line (a piece left by fracture),
+    // the rigid-mode spring keeps the elasticity invertible.
+    p.free_body = !holds_rigid_modes(mesh.nodes, p.fixed);
     return p;
 }
 

@@ -27,7 +27,8 @@ Vec3 shared_face_centroid(const TetMesh& mesh, const ElementLink& link) {
 }  // namespace
 
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
-                               std::span<const Index> node_id, const CrackSettings& settings) {
+                               std::span<const Index> node_id, const CrackSettings& settings,
+                               const std::function<bool(const Crack&)>& accept) {
     std::vector<Crack> candidates;
     for (Index a = 0; a < mesh.node_count(); ++a) {
         const Real ratio = stress.principal[a][0] / settings.tensile_strength;
@@ -56,7 +57,7 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
         const bool near = std::any_of(taken.begin(), taken.end(), [&](const Crack& t) {
             return (t.centre - c.centre).squaredNorm() < min_distance2;
         });
-        if (!near) taken.push_back(c);
+        if (!near && (!accept || accept(c))) taken.push_back(c);
     }
     return taken;
 }

@@ -4,6 +4,7 @@
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/structure_state.hpp"
 
+#include <functional>
 #include <span>
 
 namespace karst {
@@ -28,9 +29,11 @@ struct CrackSettings {
 
 /// M25: nodes whose largest effective principal stress exceeds sigma_t, in decreasing
 /// sigma'_1 / sigma_t (ties by the node's particle id, so the order of the particles does not
-/// matter), skipping nodes within `exclusion` of a crack already taken, at most `max_cracks`.
+/// matter), skipping nodes within `exclusion` of a crack already taken and cracks for which
+/// `accept` (when given) is false, at most `max_cracks`.
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
-                               std::span<const Index> node_id, const CrackSettings& settings);
+                               std::span<const Index> node_id, const CrackSettings& settings,
+                               const std::function<bool(const Crack&)>& accept = {});
 
 /// §5.6: per link, the first crack whose disk cuts the face the link stands for (-1: none): the
 /// two centroids lie on opposite sides of the crack plane and the shared face's centroid within

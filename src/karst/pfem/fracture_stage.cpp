@@ -3,6 +3,7 @@
 #include "karst/core/timer.hpp"
 #include "karst/pfem/cracks.hpp"
 #include "karst/pfem/mesh_split.hpp"
+#include "karst/pfem/rigid_modes.hpp"
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/rigid/fragment_motion.hpp"
 
@@ -71,7 +72,12 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
             stress.principal[a][0] = -std::numeric_limits<Real>::infinity();
     const CrackSettings settings{material.tensile_strength, material.fracture_energy, model.dx,
                                  model.h, model.scene.fracture.max_cracks_per_call};
-    std::vector<Crack> cracks = find_cracks(s.mesh, stress, s.node_id, settings);
+    // A crack whose disk cuts no unbroken link (the crack is already there) does not count.
+    const auto cuts_something = [&](const Crack& c) {
+        const std::vector<Index> cut = links_cut(s.mesh, s.links, std::span(&c, 1));
+        return std::any_of(cut.begin(), cut.end(), [](Index k) { return k >= 0; });
+    };
+    std::vector<Crack> cracks = find_cracks(s.mesh, stress, s.node_id, settings, cuts_something);
     if (cracks.empty()) return false;
     const std::vector<Index> cutter = links_cut(s.mesh, s.links, cracks);
     std::vector<Index> links_broken(cracks.size(), 0);
@@ -125,13 +131,23 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
 
     // Topology: components held by an anchor stay in the structure (with no anchor at all, the
     // biggest one does); every other component becomes a free rigid fragment.
-    std::vector<char> anchored(split.components, 0);
+    // A component is held when its fixed nodes hold all six rigid modes (one anchored node is a
+    // hinge, and a hinged piece falls).
     std::vector<Index> tets_in(split.components, 0);
+    std::vector<std::vector<Vec3>> held_x(split.components);
+    std::vector<std::vector<std::uint8_t>> held_axes(split.components);
+    std::vector<char> seen(split.mesh.node_count(), 0);
     for (Index e = 0; e < split.mesh.tet_count(); ++e) {
-        ++tets_in[split.component[e]];
+        const Index c = split.component[e];
+        ++tets_in[c];
         for (Index k : split.mesh.tets[e])
-            if (problem.fixed[split.source[k]]) anchored[split.component[e]] = 1;
+            if (!seen[k] && problem.fixed[split.source[k]])
+                seen[k] = 1, held_x[c].push_back(split.mesh.nodes[k]),
+                held_axes[c].push_back(problem.fixed[split.source[k]]);
     }
+    std::vector<char> anchored(split.components, 0);
+    for (Index c = 0; c < split.components; ++c)
+        anchored[c] = holds_rigid_modes(held_x[c], held_axes[c]);
     if (std::none_of(anchored.begin(), anchored.end(), [](char c) { return c; }))
         anchored[std::max_element(tets_in.begin(), tets_in.end()) - tets_in.begin()] = 1;
     std::vector<char> keep(split.mesh.tet_count());

@@ -4,6 +4,7 @@
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/face_links.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace karst {
@@ -58,11 +59,17 @@ void build(const Model& model, State& state, size_t slot) {
     StructureState& st = state.structures;
     Structure& s = st.structures[slot];
     const PorousParticles& p = state.porous.particles;
-    std::vector<Vec3> x;
     s.node_id.clear();
     for (Index i = 0; i < p.size(); ++i)
-        if (p.fragment[i] == s.fragment)
-            x.push_back(st.rest_x[p.id[i]]), s.node_id.push_back(p.id[i]);
+        if (p.fragment[i] == s.fragment) s.node_id.push_back(p.id[i]);
+    // Nodes in the lexicographic order of their rest positions: the mesh (and every crack on it)
+    // does not depend on the order of the particles.
+    std::sort(s.node_id.begin(), s.node_id.end(), [&](Index a, Index b) {
+        const Vec3 &xa = st.rest_x[a], &xb = st.rest_x[b];
+        return std::lexicographical_compare(xa.begin(), xa.end(), xb.begin(), xb.end());
+    });
+    std::vector<Vec3> x;
+    for (Index id : s.node_id) x.push_back(st.rest_x[id]);
     s.mesh = mesh_points(model, x, st.timings);
     s.mesh_version = st.next_mesh_version++;
     s.links = face_links(s.mesh);

@@ -25,6 +25,9 @@ struct PorousParticles {
     std::vector<Index> material;  ///< index of the material's PoreWaterLaw (the scene's solid)
     std::vector<Mat3> body_permeability;  ///< K0 in the body frame (M12), m^2
     std::vector<Index> id;  ///< stable over removals (the PFEM mesh's node -> particle map)
+    /// The id of the particle this one was split from by fracture (M27), its own id if none:
+    /// the halves of one particle overlap and push each other by no contact spring.
+    std::vector<Index> origin;
     Index size() const { return Index(x.size()); }
     Index material_of(Index i) const { return material.empty() ? 0 : material[i]; }
     /// Calls f(a.attr, b.attr, ...) for every attribute of the sets (core/soa.hpp).
@@ -33,7 +36,7 @@ struct PorousParticles {
         f(s.x...), f(s.volume...), f(s.porosity...), f(s.absorbed_mass...), f(s.solid_mass...),
             f(s.v...);
         f(s.permeability...), f(s.fragment...), f(s.rest...), f(s.material...),
-            f(s.body_permeability...), f(s.id...);
+            f(s.body_permeability...), f(s.id...), f(s.origin...);
     }
 };
 

@@ -25,7 +25,7 @@ Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbo
     parallel_for(p.size(), [&](Index i) {
         Vec3 sum = Vec3::Zero();
         neighbours.for_each(i, [&](Index j) {
-            if (p.fragment[i] == p.fragment[j]) return;
+            if (p.fragment[i] == p.fragment[j] || p.origin[i] == p.origin[j]) return;
             // Evaluated in (min, max) order so that the pair's two forces are bitwise opposite.
             const Index lo = std::min(i, j), hi = std::max(i, j);
             const Vec3 x = p.x[lo] - p.x[hi];

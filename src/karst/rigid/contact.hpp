@@ -2,7 +2,8 @@
 // Contact springs between porous particles of different fragments (method.md §4.2):
 //   F_{i<-j} = [k_c (d0 - r) - c_c (v_ij . r_hat)] r_hat   for r < d0 = dx,
 // applied in equal and opposite pairs. Springs inside one fragment would cancel in its rigid sum,
-// so only pairs across fragments count.
+// so only pairs across fragments count; and none between the halves of one split particle (M27),
+// which overlap by construction.
 #include "karst/porous/pore_water.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 

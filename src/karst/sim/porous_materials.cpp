@@ -59,7 +59,7 @@ PorousParticles porous_particles_at_rest(const Model& model, const PorousBody& b
             p.body_permeability.push_back(body.body_permeability[i]);
         p.fragment.push_back(fragment), p.material.push_back(body.solid),
             p.rest.push_back(Vec3::Zero());
-        p.id.push_back(Index(i));
+        p.id.push_back(Index(i)), p.origin.push_back(Index(i));
     }
     return p;
 }

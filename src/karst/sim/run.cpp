@@ -59,6 +59,13 @@ nlohmann::json biot_stats(const PfemTimings& t) {
             {"all_converged", t.all_converged}};
 }
 
+nlohmann::json fracture_stats(const FractureCounts& f) {
+    return {{"cracks", f.cracks},
+            {"links_broken", f.links_broken},
+            {"nodes_split", f.nodes_split},
+            {"fragments_created", f.fragments_created}};
+}
+
 /// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current
 /// positions (dissolution may have removed particles since the step's search).
 PointSet porous_frame(const Model& model, const State& state) {
@@ -193,6 +200,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
               {"grains_final", final_totals.grains}}},
             {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
             {"biot", biot_stats(pfem)},
+            {"fracture", fracture_stats(state.structures.fracture)},
             {"mesh",
              {{"kept", quality.kept},
               {"polyhedra", quality.polyhedra},

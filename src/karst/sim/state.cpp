@@ -18,7 +18,7 @@ void make_porous(const Model& model, PorousState& porous, std::int64_t& next_id)
         const Index first = p.size(), fragment = Index(porous.fragments.size());
         append_attributes(p, porous_particles_at_rest(model, body, fragment));
         const Index n = p.size() - first;
-        for (Index i = first; i < p.size(); ++i) p.id[i] = next_id++;
+        for (Index i = first; i < p.size(); ++i) p.id[i] = p.origin[i] = next_id++;
         std::vector<Real> mass(n);
         for (Index i = 0; i < n; ++i)
             mass[i] = p.solid_mass[first + i] + p.absorbed_mass[first + i];

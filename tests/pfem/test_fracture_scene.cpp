@@ -1,0 +1,198 @@
+// Fracture inside the engine (issue 13, method.md §5.6): what a crack does to State. Mass, pore
+// water and momentum across node splits and new fragments; cracks that do not depend on the
+// particle order or the thread count; an overhang that breaks off under its weight and falls.
+#include "support/simulate.hpp"
+
+#include "karst/core/parallel.hpp"
+#include "karst/core/soa.hpp"
+#include "karst/pfem/fracture_stage.hpp"
+#include "karst/pfem/structure_stages.hpp"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+namespace karst {
+namespace {
+
+/// A thin, wet bar held at one end and pulled at the other at three times its strength: one call
+/// cracks it into pieces. G_c is small, so each crack spans the section.
+std::string pulled_bar(bool fracture) {
+    return fmt::format(R"({{
+      "name": "pulled_bar", "particle_spacing": 0.05, "gravity": [0, 0, 0],
+      "poroelastic": {{ "time_step": 0.05 }}, "fracture": {{ "enabled": {} }},
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [1.0, 0.1, 0.1] }},
+        "material": {{ "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "initial_saturation": 0.7,
+                        "tensile_strength": 1e5, "fracture_energy": 1e-3 }},
+        "constraints": [
+          {{ "kind": "drained", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] }} }},
+          {{ "kind": "fixed", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] }} }},
+          {{ "kind": "traction", "traction": [3e5, 0, 0], "region": {{ "type": "box", "min": [1, -1, -1], "max": [2, 2, 2] }} }} ] }} ]
+    }})",
+                       fracture);
+}
+
+struct Totals {
+    Real mass = 0, water = 0;
+    Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
+};
+
+Totals totals(const PorousParticles& p) {
+    Totals t;
+    for (Index i = 0; i < p.size(); ++i) {
+        const Real m = p.solid_mass[i] + p.absorbed_mass[i];
+        t.mass += m, t.water += p.absorbed_mass[i];
+        t.momentum += m * p.v[i], t.angular += m * p.x[i].cross(p.v[i]);
+    }
+    return t;
+}
+
+TEST(FractureScene, SplitsAndNewFragmentsKeepMassWaterAndMomentum) {
+    test::Simulation sim(pulled_bar(false));
+    sim.advance();  // one Biot call, not yet tested for cracks
+    ASSERT_EQ(sim.state.structures.timings.biot_calls, 1);
+    PorousParticles& p = sim.state.porous.particles;
+    // Give the particles a rigid motion plus a shear, so that momentum is not trivially zero.
+    for (Index i = 0; i < p.size(); ++i)
+        p.v[i] =
+            Vec3(0.3, -0.2, 0.1) + Vec3(0.5, 1.0, -2.0).cross(p.x[i]) + Vec3(0, 0.4 * p.x[i][0], 0);
+    const Totals before = totals(p);
+    const Index n_before = p.size();
+    sim.model.scene.fracture.enabled = true;
+    ASSERT_TRUE(fracture_structures(sim.model, sim.state, sim.state.time));
+    const FractureCounts& c = sim.state.structures.fracture;
+    EXPECT_GT(c.cracks, 0);
+    EXPECT_GT(c.nodes_split, 0);
+    EXPECT_EQ(p.size(), n_before + c.nodes_split);  // one copy per split node (two-way cuts)
+    EXPECT_GE(c.fragments_created, 1);
+    const Totals after = totals(p);
+    EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);
+    EXPECT_NEAR(after.water, before.water, 1e-12 * before.water);
+    EXPECT_LT((after.momentum - before.momentum).norm(), 1e-12 * before.mass * 1);
+    EXPECT_LT((after.angular - before.angular).norm(), 1e-12 * before.angular.norm());
+    // Every new fragment carries exactly its members' momentum, about its centre and in total.
+    const auto& fragments = sim.state.porous.fragments;
+    for (size_t f = 1; f < fragments.size(); ++f) {
+        const Fragment& fr = fragments[f];
+        ASSERT_FALSE(fr.anchored);
+        Real m = 0;
+        Vec3 P = Vec3::Zero(), L = Vec3::Zero();
+        for (Index i = 0; i < p.size(); ++i) {
+            if (p.fragment[i] != Index(f)) continue;
+            const Real mi = p.solid_mass[i] + p.absorbed_mass[i];
+            m += mi, P += mi * p.v[i], L += mi * p.x[i].cross(p.v[i]);
+        }
+        EXPECT_NEAR(fr.mass, m, 1e-12 * m);
+        EXPECT_LT((fr.mass * fr.velocity - P).norm(), 1e-12 * P.norm() + 1e-15);
+        const Vec3 L_rigid = fr.mass * fr.centre.cross(fr.velocity) + fr.angular_momentum;
+        EXPECT_LT((L_rigid - L).norm(), 1e-12 * L.norm() + 1e-15);
+    }
+    // The structure keeps the rest, on a mesh whose nodes are its particles.
+    const Structure& s = sim.state.structures.structures.at(0);
+    for (Index a = 0; a < s.mesh.node_count(); ++a)
+        ASSERT_EQ(sim.state.structures.node_of[s.node_id[a]], std::make_pair(Index(0), a));
+    // ... and the run goes on: the next calls solve the cracked mesh.
+    sim.run_until(sim.state.time + 3 * 0.05 - 1e-9);
+    EXPECT_EQ(sim.state.structures.timings.biot_calls, 4);
+}
+
+std::vector<CrackRecord> sorted_cracks(std::vector<CrackRecord> c) {
+    std::sort(c.begin(), c.end(), [](const CrackRecord& a, const CrackRecord& b) {
+        return std::lexicographical_compare(a.centre.begin(), a.centre.end(), b.centre.begin(),
+                                            b.centre.end());
+    });
+    return c;
+}
+
+TEST(FractureScene, TheCrackSetDoesNotDependOnTheParticleOrder) {
+    test::Simulation a(pulled_bar(true)), b(pulled_bar(true));
+    // b: the same particles, shuffled, and its structures built anew on them.
+    PorousParticles& p = b.state.porous.particles;
+    std::vector<std::uint32_t> perm(p.size());
+    std::iota(perm.begin(), perm.end(), 0);
+    std::shuffle(perm.begin(), perm.end(), std::mt19937(7));
+    permute_attributes(p, perm);
+    b.state.structures = StructureState{};
+    b.state.biot_cache = BiotCache{};
+    build_structures(b.model, b.state);
+    a.advance(), b.advance();
+    const auto ca = sorted_cracks(a.state.structures.cracks),
+               cb = sorted_cracks(b.state.structures.cracks);
+    ASSERT_GT(ca.size(), 0u);
+    ASSERT_EQ(ca.size(), cb.size());
+    for (size_t k = 0; k < ca.size(); ++k) {
+        EXPECT_LT((ca[k].centre - cb[k].centre).norm(), 1e-9);
+        EXPECT_LT((ca[k].normal - cb[k].normal).norm(), 1e-9);
+        EXPECT_EQ(ca[k].links_broken, cb[k].links_broken);
+    }
+    EXPECT_EQ(a.state.structures.fracture.nodes_split, b.state.structures.fracture.nodes_split);
+    EXPECT_EQ(a.state.porous.fragments.size(), b.state.porous.fragments.size());
+}
+
+TEST(FractureScene, CracksAndFragmentsAreIdenticalOnOneAndTwoThreads) {
+    auto run = [](int threads) {
+        ThreadLimit limit(threads);
+        test::Simulation sim(pulled_bar(true));
+        sim.run_until(0.3 - 1e-9);
+        return std::move(sim.state);
+    };
+    const State one = run(1), two = run(2);
+    ASSERT_EQ(one.structures.timings.biot_calls, 6);
+    ASSERT_GE(one.structures.fracture.cracks, 8);
+    ASSERT_GE(one.structures.fracture.fragments_created, 2);
+    ASSERT_EQ(one.structures.cracks.size(), two.structures.cracks.size());
+    for (size_t k = 0; k < one.structures.cracks.size(); ++k)
+        EXPECT_EQ(one.structures.cracks[k].centre, two.structures.cracks[k].centre);
+    const PorousParticles &p = one.porous.particles, &q = two.porous.particles;
+    ASSERT_EQ(p.size(), q.size());
+    EXPECT_EQ(p.x, q.x);
+    EXPECT_EQ(p.v, q.v);
+    EXPECT_EQ(p.fragment, q.fragment);
+}
+
+/// A cantilever of rock 1 m long, 0.2 m square, held at its root, under its own weight: the root
+/// stress 3 rho g L^2 / H is about 3.2e5 Pa.
+std::string overhang(Real tensile_strength) {
+    return fmt::format(R"({{
+      "name": "overhang", "particle_spacing": 0.05, "domain": {{ "min": [-0.5, -0.5, -3], "max": [1.5, 0.7, 0.7] }},
+      "poroelastic": {{ "time_step": 0.02 }},
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [1.0, 0.2, 0.2] }},
+        "material": {{ "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e7, "tensile_strength": {} }},
+        "constraints": [
+          {{ "kind": "fixed", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] }} }},
+          {{ "kind": "drained", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] }} }} ] }} ]
+    }})",
+                       tensile_strength);
+}
+
+TEST(FractureScene, AnOverhangHeavierThanItsStrengthBreaksOffAndFalls) {
+    test::Simulation weak(overhang(1e5));
+    const Index n0 = weak.state.porous.size();
+    weak.run_until(0.3);
+    const auto& fragments = weak.state.porous.fragments;
+    ASSERT_GE(fragments.size(), 2u);
+    // The biggest free fragment is most of the overhang.
+    std::vector<Index> members(fragments.size(), 0);
+    for (Index f : weak.state.porous.particles.fragment) ++members[f];
+    const size_t big = std::max_element(members.begin() + 1, members.end()) - members.begin();
+    EXPECT_GT(members[big], n0 / 2);
+    EXPECT_FALSE(fragments[big].anchored);
+    // ... and it falls freely (no floor): dv_z / dt = g over the next 0.2 s.
+    const Real v0 = fragments[big].velocity[2], t0 = weak.state.time;
+    weak.run_until(0.5);
+    const Real a = (weak.state.porous.fragments[big].velocity[2] - v0) / (weak.state.time - t0);
+    EXPECT_NEAR(a, -9.81, 0.01 * 9.81);
+    EXPECT_LT(weak.state.porous.fragments[big].centre[2], -0.2);
+
+    // Ten times stronger than its root stress: it never cracks.
+    test::Simulation strong(overhang(3e6));
+    strong.run_until(0.3);
+    EXPECT_EQ(strong.state.structures.fracture.cracks, 0);
+    EXPECT_EQ(strong.state.porous.fragments.size(), 1u);
+}
+
+}  // namespace
+}  // namespace karst
