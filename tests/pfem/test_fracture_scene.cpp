@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <numeric>
 #include <random>
 
@@ -192,6 +194,53 @@ TEST(FractureScene, AnOverhangHeavierThanItsStrengthBreaksOffAndFalls) {
     strong.run_until(0.3);
     EXPECT_EQ(strong.state.structures.fracture.cracks, 0);
     EXPECT_EQ(strong.state.porous.fragments.size(), 1u);
+}
+
+/// A free bar 1.2 m x 0.3 m x 0.3 m on a 0.1 m lattice, drained, with the given constraints.
+std::string free_bar(const std::string& constraints) {
+    return R"({
+      "name": "ramp", "particle_spacing": 0.1, "gravity": [0, 0, 0], "poroelastic": { "time_step": 0.01 },
+      "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [1.2, 0.3, 0.3] },
+        "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "biot_coefficient": 0.9,
+                      "tensile_strength": 1e5 },
+        "constraints": [ )" +
+           constraints + R"( ] } ]
+    })";
+}
+
+/// Runs until the first crack; returns its time (or a negative time when none by `end`).
+Real first_crack_time(test::Simulation& sim, Real end) {
+    while (sim.state.time < end && sim.state.structures.cracks.empty()) sim.advance();
+    return sim.state.structures.cracks.empty() ? -1 : sim.state.structures.cracks[0].time;
+}
+
+TEST(FractureScene, ABarUnderARampedTractionCracksAtItsStrengthNormalToTheLoad) {
+    // The traction rises by 1 % of sigma_t per call (1 kPa per 0.01 s).
+    test::Simulation sim(free_bar(R"(
+      { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
+      { "kind": "traction", "traction": [-1e5, 0, 0], "table": [[0, 0], [2, 2]],
+        "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+      { "kind": "traction", "traction": [1e5, 0, 0], "table": [[0, 0], [2, 2]],
+        "region": { "type": "box", "min": [1.2, -1, -1], "max": [2, 2, 2] } })"));
+    const Real t = first_crack_time(sim, 2);
+    ASSERT_GT(t, 0) << "no crack under twice the strength";
+    EXPECT_GE(t, 0.95);
+    EXPECT_LE(t, 1.05);
+    for (const CrackRecord& c : sim.state.structures.cracks)
+        EXPECT_GT(std::abs(c.normal[0]), std::cos(5 * std::numbers::pi / 180));
+}
+
+TEST(FractureScene, RaisingThePorePressureAloneCracksWhenBTimesPReachesTheStrength) {
+    // No load; the drained pressure rises by 1 % of sigma_t / B per call. sigma' = B p I.
+    const Real p_crack = 1e5 / 0.9;
+    test::Simulation sim(free_bar(fmt::format(
+        R"({{ "kind": "drained", "pressure": {}, "table": [[0, 0], [2, 2]],
+              "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] }} }})",
+        p_crack)));
+    const Real t = first_crack_time(sim, 2);
+    ASSERT_GT(t, 0) << "no crack at twice the pressure";
+    EXPECT_GE(t, 0.95);
+    EXPECT_LE(t, 1.05);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "support/files.hpp"
 #include "support/simulate.hpp"
 
+#include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/porosity.hpp"
 #include "karst/scene/scene_error.hpp"
 
@@ -128,6 +129,18 @@ TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
               "/porous_solids/0/constraints/0/axes");
     EXPECT_EQ(refuse(edit("\"youngs_modulus\": 7.2", "\"youngs_modulus\": -7.2")).path,
               "/porous_solids/0/material/youngs_modulus");
+    // Time tables: rows of two numbers, times from 0 on and increasing.
+    const std::string tabled = "\"kind\": \"drained\", \"table\": ";
+    const auto table_error = [&](const std::string& rows) {
+        return refuse(edit("\"kind\": \"drained\"", tabled + rows));
+    };
+    EXPECT_EQ(table_error("[]").path, "/porous_solids/0/constraints/5/table");
+    EXPECT_EQ(table_error("[[0, 1], [2]]").path, "/porous_solids/0/constraints/5/table/1");
+    EXPECT_EQ(table_error("[[-1, 1]]").path, "/porous_solids/0/constraints/5/table/0/0");
+    const SceneError backwards = table_error("[[0, 1], [2, 3], [1, 0]]");
+    EXPECT_EQ(backwards.path, "/porous_solids/0/constraints/5/table/2/0");
+    EXPECT_NE(backwards.expected.find("after the previous row's 2 s"), std::string::npos);
+    EXPECT_EQ(table_error("[[0, \"a\"]]").path, "/porous_solids/0/constraints/5/table/0/1");
     // Fluid inside a porous solid.
     const SceneError overlap =
         refuse(edit("\"porous_solids\": [",
@@ -169,6 +182,36 @@ TEST(PoroelasticScene, CliWritesMeshFramesListedInRunPvdAndStats) {
         EXPECT_TRUE(stats["phases"].contains(phase)) << phase;
     EXPECT_GT(stats["biot"]["iterations"].get<int>(), 0);
     std::filesystem::remove_all(out);
+}
+
+TEST(PoroelasticScene, APlatenMovedByATimeTableStrainsTheBarUniformly) {
+    // A bar on rollers at both ends (x held there), its x = 1.2 end moved by a ramp of 2 mm per
+    // second: uniaxial stress E delta / L everywhere, L the distance between the end layers (to
+    // 1e-5: the rigid-mode spring of the unheld y, z and twist modes, 1e-8 diag K, pulls a little).
+    test::Simulation sim(R"({
+      "name": "platen_ramp", "particle_spacing": 0.1, "gravity": [0, 0, 0], "poroelastic": { "time_step": 0.25 },
+      "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [1.2, 0.3, 0.3] },
+        "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "poisson_ratio": 0.25,
+                      "tensile_strength": 1e9 },
+        "constraints": [
+          { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
+          { "kind": "fixed", "axes": "x", "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+          { "kind": "fixed", "axes": "x", "displacement": [0.002, 0, 0], "table": [[0, 0], [10, 10]],
+            "region": { "type": "box", "min": [1.2, -1, -1], "max": [2, 2, 2] } } ] } ]
+    })");
+    for (int call = 1; call <= 4; ++call) {
+        sim.advance();
+        const Real t = sim.state.time, delta = 0.002 * t, L = 1.1;
+        const Structure& s = sim.state.structures.structures.at(0);
+        const BiotProblem& problem =
+            sim.state.biot_cache.find(0, s.mesh_version)->solver->problem();
+        const NodalStress stress = nodal_stress(s.mesh, problem.material, s.fields);
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            ASSERT_NEAR(stress.effective[a](0, 0), 1e6 * delta / L, 1e-5 * 1e6 * delta / L)
+                << "node " << a << " at t = " << t;
+            ASSERT_NEAR(stress.effective[a](1, 1), 0, 1e-5 * 1e6 * delta / L);
+        }
+    }
 }
 
 }  // namespace

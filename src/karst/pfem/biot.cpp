@@ -30,12 +30,13 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
             polyhedral_elements(mesh, 1e-4 * spacing / std::max<Index>(1, mesh.tet_count()));
         assemble_polyhedral_mechanics();
         std::tie(K_ff, K_fc) = u_dofs.split(K);
-        elastic_lift = K_fc * u_dofs.gather_prescribed(u_prescribed);
     } else {
         assemble_p1_mechanics();
     }
+    f_body = f_ext;
+    f_extra = Vector::Zero(3 * n);
+    apply_boundary_values(problem.nodal_force, problem.prescribed_u, problem.drained_pressure);
     mass_ff = p_dofs.split(mass).first;
-    f_problem = f_ext;
     assemble_flow();
     t_assembly = watch.seconds();
     Stopwatch factor_watch;
@@ -174,7 +175,31 @@ void BiotSolver::set_mobility(std::vector<Mat3> mobility) {
 
 void BiotSolver::set_extra_loads(const std::vector<Vec3>& loads) {
     KARST_CHECK(loads.size() == size_t(m_impl->n));
-    m_impl->f_ext = m_impl->f_problem + Eigen::Map<const Vector>(loads[0].data(), 3 * m_impl->n);
+    m_impl->f_extra = Eigen::Map<const Vector>(loads[0].data(), 3 * m_impl->n);
+    m_impl->f_ext = m_impl->f_problem + m_impl->f_extra;
+}
+
+void BiotSolver::set_boundary_values(const std::vector<Vec3>& nodal_force,
+                                     const std::vector<Vec3>& prescribed_u,
+                                     const std::vector<Real>& drained_pressure) {
+    m_impl->apply_boundary_values(nodal_force, prescribed_u, drained_pressure);
+}
+
+void BiotSolver::Impl::apply_boundary_values(const std::vector<Vec3>& nodal_force,
+                                             const std::vector<Vec3>& prescribed_u,
+                                             const std::vector<Real>& drained_pressure) {
+    f_problem = f_body;
+    for (Index a = 0; a < Index(nodal_force.size()); ++a)
+        f_problem.segment<3>(3 * a) += nodal_force[a];
+    f_ext = f_problem + f_extra;
+    for (Index a = 0; a < n; ++a)
+        for (int c = 0; c < 3; ++c)
+            if (u_dofs.free_index[3 * a + c] < 0 && !prescribed_u.empty() &&
+                (problem.fixed[a] & (1 << c)))
+                u_prescribed[3 * a + c] = prescribed_u[a][c];
+    for (Index a = 0; a < n; ++a)
+        if (problem.drained[a] && !drained_pressure.empty()) p_prescribed[a] = drained_pressure[a];
+    elastic_lift = K_fc * u_dofs.gather_prescribed(u_prescribed);
 }
 
 const BiotProblem& BiotSolver::problem() const {

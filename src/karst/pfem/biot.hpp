@@ -115,6 +115,13 @@ public:
     /// the next call on: the fluid's forces on a coupled fragment (method.md §5.3).
     void set_extra_loads(const std::vector<Vec3>& loads);
 
+    /// Boundary values from the next call on (time tables, method.md §5.3): nodal loads that
+    /// replace the problem's nodal_force, and the values of the already prescribed displacement
+    /// components and drained pressures (an empty array leaves those unchanged).
+    void set_boundary_values(const std::vector<Vec3>& nodal_force,
+                             const std::vector<Vec3>& prescribed_u,
+                             const std::vector<Real>& drained_pressure);
+
     const BiotProblem& problem() const;
     Real seconds_assembly() const;
     Real seconds_elastic_factorisation() const;

@@ -74,7 +74,10 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
 
     lumped_volume = Vector::Zero(n);
     f_ext = Vector::Zero(3 * n);
-    elastic_lift = Vector::Zero(nf);
+    std::vector<int> prescribed_index(3 * n, -1);
+    for (int i = 0, k = 0; i < 3 * n; ++i)
+        if (u_dofs.free_index[i] < 0) prescribed_index[i] = k++;
+    std::vector<Triplets> lift_entries(n);  // K_fc, per column-owning node b
     parallel_for(n, [&](Index b) {
         const auto& nb = neighbours[b];
         std::vector<Mat3> block(nb.size(), Mat3::Zero());
@@ -113,7 +116,7 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
                                                     ? value * (1 + problem.rigid_mode_spring)
                                                     : value;
                     } else {
-                        elastic_lift[col] += value * u_prescribed[3 * nb[pos] + c];
+                        lift_entries[b].emplace_back(col, prescribed_index[3 * nb[pos] + c], value);
                     }
                 }
         }
@@ -125,8 +128,10 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
         for (size_t pos = 0; pos < nb.size(); ++pos)
             mass.innerIndexPtr()[at] = int(nb[pos]), mass.valuePtr()[at++] = consistent[pos];
     });
-    for (Index a = 0; a < Index(problem.nodal_force.size()); ++a)
-        f_ext.segment<3>(3 * a) += problem.nodal_force[a];
+    Triplets lift;
+    for (const Triplets& t : lift_entries) lift.insert(lift.end(), t.begin(), t.end());
+    K_fc.resize(nf, 3 * n - nf);
+    K_fc.setFromTriplets(lift.begin(), lift.end());
     storage = problem.material.storage * lumped_volume;
 }
 
@@ -174,8 +179,6 @@ void BiotSolver::Impl::assemble_polyhedral_mechanics() {
     for (Index a = 0; a < n; ++a) mass.insert(a, a) = lumped_volume[a];
     if (problem.free_body)
         for (int i = 0; i < 3 * n; ++i) K.coeffRef(i, i) *= 1 + problem.rigid_mode_spring;
-    for (Index a = 0; a < Index(problem.nodal_force.size()); ++a)
-        f_ext.segment<3>(3 * a) += problem.nodal_force[a];
     storage = problem.material.storage * lumped_volume;
 }
 

@@ -22,7 +22,9 @@ struct BiotSolver::Impl {
     Vector lumped_volume, storage;  // per node: M_a, S_a
     Vector gravity_flux;            // b
     Vector f_ext;                   // body force + nodal loads
-    Vector f_problem;  // body force + the problem's nodal_force (f_ext without extra loads)
+    Vector f_body;                  // body force
+    Vector f_problem;  // body force + the nodal loads of the boundary (the problem's at first)
+    Vector f_extra;    // set_extra_loads
     Vector u_prescribed, p_prescribed;
 
     DofSplit u_dofs{{}}, p_dofs{{}};
@@ -53,6 +55,11 @@ struct BiotSolver::Impl {
     void assemble_flow();
     /// Free and prescribed unknowns, with the prescribed values.
     void split_dofs();
+    /// New nodal loads (replacing the problem's), prescribed displacements and drained pressures
+    /// (empty: unchanged), and the lift K_fc u_c of the new displacements.
+    void apply_boundary_values(const std::vector<Vec3>& nodal_force,
+                               const std::vector<Vec3>& prescribed_u,
+                               const std::vector<Real>& drained_pressure);
     /// (S + L M + dt H)_ff, factorised when dt or the mobility changed.
     void factorise_flow(Real dt, Real L);
     /// One call: the fixed-stress (or fixed-strain) iteration of M22.

@@ -61,6 +61,54 @@ BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
     return b;
 }
 
+namespace {
+
+/// Whether node position x lies on the constraint's region: inside it or within 3/4 of a
+/// spacing (the outer particle layer sits half a spacing inside the geometry, the next 1.5).
+bool on_region(const Model& model, const Constraint& c, const Vec3& x) {
+    return c.region.signed_distance(x) <= 0.75 * model.dx;
+}
+
+/// Nodes touching a static wall (within a spacing of its particle skin) are anchored, u = 0
+/// (method.md §5.3): a block resting on the ground is held by it.
+bool touches_wall(const Model& model, const Vec3& x) {
+    for (const Wall& w : model.scene.walls) {
+        const Real d = w.shape.signed_distance(x);
+        if (w.kind == Wall::Kind::Obstacle ? d <= model.dx : d >= -model.dx) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
+                               Real time) {
+    const Index n = mesh.node_count();
+    BoundaryValues b{std::vector<Vec3>(n, Vec3::Zero()), std::vector<Vec3>(n, Vec3::Zero()),
+                     std::vector<Real>(n, 0)};
+    for (const Constraint& c : solid.constraints) {
+        const Real factor = c.table.at(time);
+        auto inside = [&](const Vec3& x) { return on_region(model, c, x); };
+        if (c.kind == Constraint::Kind::Traction) {
+            const auto loads = traction_loads(mesh, factor * c.traction, inside);
+            for (Index a = 0; a < n; ++a) b.nodal_force[a] += loads[a];
+            continue;
+        }
+        for (Index a = 0; a < n; ++a) {
+            if (!inside(mesh.nodes[a])) continue;
+            if (c.kind == Constraint::Kind::Drained) {
+                b.drained_pressure[a] = factor * c.pressure;
+                continue;
+            }
+            for (int k = 0; k < 3; ++k)
+                if (c.axes & (1 << k)) b.prescribed_u[a][k] = factor * c.displacement[k];
+        }
+    }
+    for (Index a = 0; a < n; ++a)
+        if (touches_wall(model, mesh.nodes[a])) b.prescribed_u[a] = Vec3::Zero();
+    return b;
+}
+
 BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                          const std::vector<Mat3>& node_tensors) {
     BiotProblem p;
@@ -70,34 +118,22 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     for (Index e = 0; e < mesh.tet_count(); ++e)
         p.mobility[e] = tet_mean(mesh.tets[e], node_tensors) / solid.material.darcy_viscosity;
     const Index n = mesh.node_count();
-    p.fixed.assign(n, 0), p.drained.assign(n, 0), p.drained_pressure.assign(n, 0),
-        p.nodal_force.assign(n, Vec3::Zero());
-    // A node is on a region when inside it or within 3/4 of a spacing: the outer particle layer
-    // sits half a spacing inside the geometry, the next one 1.5 spacings.
-    const Real reach = 0.75 * model.dx;
-    for (const Constraint& c : solid.constraints) {
-        auto inside = [&](const Vec3& x) { return c.region.signed_distance(x) <= reach; };
-        if (c.kind == Constraint::Kind::Traction) {
-            const auto loads = traction_loads(mesh, c.traction, inside);
-            for (Index a = 0; a < n; ++a) p.nodal_force[a] += loads[a];
-            continue;
-        }
+    p.fixed.assign(n, 0), p.drained.assign(n, 0);
+    for (const Constraint& c : solid.constraints)
         for (Index a = 0; a < n; ++a) {
-            if (!inside(mesh.nodes[a])) continue;
+            if (c.kind == Constraint::Kind::Traction || !on_region(model, c, mesh.nodes[a]))
+                continue;
             if (c.kind == Constraint::Kind::Fixed)
                 p.fixed[a] |= c.axes;
             else
-                p.drained[a] = 1, p.drained_pressure[a] = c.pressure;
+                p.drained[a] = 1;
         }
-    }
-    // Nodes touching a static wall (within a spacing of its particle skin) are anchored, u = 0
-    // (method.md §5.3): a block resting on the ground is held by it.
-    for (const Wall& w : model.scene.walls)
-        for (Index a = 0; a < n; ++a) {
-            const Real d = w.shape.signed_distance(mesh.nodes[a]);
-            if (w.kind == Wall::Kind::Obstacle ? d <= model.dx : d >= -model.dx)
-                p.fixed[a] = FixAll;
-        }
+    for (Index a = 0; a < n; ++a)
+        if (touches_wall(model, mesh.nodes[a])) p.fixed[a] = FixAll;
+    BoundaryValues values = boundary_values(model, solid, mesh, 0);
+    p.nodal_force = std::move(values.nodal_force);
+    p.prescribed_u = std::move(values.prescribed_u);
+    p.drained_pressure = std::move(values.drained_pressure);
     // Without anchors, or anchored only at a point or along a line (a piece left by fracture),
     // the rigid-mode spring keeps the elasticity invertible.
     p.free_body = !holds_rigid_modes(mesh.nodes, p.fixed);

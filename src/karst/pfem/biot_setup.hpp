@@ -8,6 +8,8 @@
 #include "karst/pfem/structure_state.hpp"
 #include "karst/sim/model.hpp"
 
+#include <algorithm>
+
 namespace karst {
 
 /// §5.1 mesh of the points x (rest positions, spacing dx) with the scene's alpha, delta and
@@ -17,9 +19,24 @@ TetMesh mesh_points(const Model& model, const std::vector<Vec3>& x, PfemTimings&
 /// The saturated Biot material of a porous material (method.md §5.3).
 BiotMaterial biot_material(const Model& model, const PorousMaterial& material);
 
+/// The values of the scene's constraints at `time` (their tables' factors) on `mesh`: nodal
+/// forces of the tractions, prescribed displacements (on the fixed axes) and drained pressures.
+struct BoundaryValues {
+    std::vector<Vec3> nodal_force, prescribed_u;
+    std::vector<Real> drained_pressure;
+};
+BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
+                               Real time);
+
+/// Whether some constraint of the solid changes in time.
+inline bool has_time_table(const PorousSolid& solid) {
+    return std::any_of(solid.constraints.begin(), solid.constraints.end(),
+                       [](const Constraint& c) { return !c.table.rows.empty(); });
+}
+
 /// The Biot problem of `solid` on `mesh`, whose nodes are world positions: mobility from the
-/// nodal tensors K0, the scene's constraints (fixed, drained, traction), and anchors where a
-/// node lies within a spacing of a static wall.
+/// nodal tensors K0, the scene's constraints (fixed, drained, traction) at t = 0, and anchors
+/// where a node lies within a spacing of a static wall.
 BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                          const std::vector<Mat3>& node_tensors);
 

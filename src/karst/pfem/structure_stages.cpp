@@ -200,7 +200,7 @@ void remesh_structures(const Model& model, State& state) {
     }
 }
 
-void solve_structures(const Model& model, State& state) {
+void solve_structures(const Model& model, State& state, Real time) {
     StructureState& st = state.structures;
     const PorousParticles& p = state.porous.particles;
     const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
@@ -219,6 +219,14 @@ void solve_structures(const Model& model, State& state) {
             if (from_pore_water && !drained[a])
                 s.fields.p[a] = law.pore_pressure(
                     law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
+        }
+        if (has_time_table(model.scene.porous_solids[s.solid])) {
+            // Backward Euler: the boundary values at the end of the call's interval.
+            const BoundaryValues b =
+                boundary_values(model, model.scene.porous_solids[s.solid], s.mesh, time);
+            solver.set_boundary_values(b.nodal_force, b.prescribed_u, b.drained_pressure);
+            for (Index a = 0; a < s.mesh.node_count(); ++a)
+                if (drained[a]) s.fields.p[a] = b.drained_pressure[a];
         }
         solver.set_extra_loads(loads);
         s.u_from = s.fields.u;  // where the particles are now

@@ -41,9 +41,10 @@ Real time_to_next_biot_call(const Model& model, const State& state);
 /// the new rest state).
 void remesh_structures(const Model& model, State& state);
 
-/// One Biot call per structure over the time since the last (M22), loaded by the mean force
-/// since then (§5.3), with p^n from the pore water (M5) unless the Biot pressure is carried.
-void solve_structures(const Model& model, State& state);
+/// One Biot call per structure over the time since the last (M22), ending at `time`: loaded by
+/// the mean force since then (§5.3) and the constraints' values at `time` (time tables), with
+/// p^n from the pore water (M5) unless the Biot pressure is carried.
+void solve_structures(const Model& model, State& state, Real time);
 
 /// §5.4: porosity (M23), bulk volume V0 (1 + eps_v) and permeability (M24) into the particles
 /// and the next call's mobility. Returns true when some particle's volume or permeability moved

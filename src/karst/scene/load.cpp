@@ -172,6 +172,10 @@ Scene parse_scene(const std::string& text) {
                                     (axes.find('y') != std::string::npos ? 2 : 0) |
                                     (axes.find('z') != std::string::npos ? 4 : 0));
             con.pressure = cj["pressure"], con.traction = vec3(cj["traction"]);
+            con.displacement = vec3(cj["displacement"]);
+            if (cj.contains("table"))
+                for (const json& row : cj["table"])
+                    con.table.rows.emplace_back(row[0].get<Real>(), row[1].get<Real>());
             solid.constraints.push_back(std::move(con));
         }
         s.porous_solids.push_back(std::move(solid));

@@ -83,14 +83,34 @@ struct WetRegion {
     Real saturation{};
 };
 
-/// A boundary condition of the Biot problem on a region of a porous solid.
+/// A piecewise-linear factor of time: constant before the first row and after the last; 1 when
+/// it has no rows.
+struct TimeTable {
+    std::vector<std::pair<Real, Real>> rows;  ///< (t in s, factor), t increasing
+    Real at(Real t) const {
+        if (rows.empty()) return 1;
+        if (t <= rows.front().first) return rows.front().second;
+        for (size_t k = 1; k < rows.size(); ++k)
+            if (t <= rows[k].first) {
+                const auto [t0, f0] = rows[k - 1];
+                const auto [t1, f1] = rows[k];
+                return f0 + (f1 - f0) * (t - t0) / (t1 - t0);
+            }
+        return rows.back().second;
+    }
+};
+
+/// A boundary condition of the Biot problem on a region of a porous solid. Its value (traction,
+/// pressure or displacement) is multiplied by the table's factor at the time of each Biot call.
 struct Constraint {
     enum class Kind { Fixed, Drained, Traction };
     Kind kind{};
     Shape region;
-    std::uint8_t axes{};           ///< Fixed: bits x = 1, y = 2, z = 4
-    Real pressure{};               ///< Drained, Pa
-    Vec3 traction = Vec3::Zero();  ///< Traction, Pa
+    std::uint8_t axes{};               ///< Fixed: bits x = 1, y = 2, z = 4
+    Vec3 displacement = Vec3::Zero();  ///< Fixed, m
+    Real pressure{};                   ///< Drained, Pa
+    Vec3 traction = Vec3::Zero();      ///< Traction, Pa
+    TimeTable table;
     std::string path;
 };
 

@@ -222,7 +222,8 @@ std::vector<KeySpec> make_schema() {
             "sit half a spacing inside the geometry). Unconstrained: free "
             "body (rigid modes held by a weak spring), no flux."),
         required("/porous_solids/[]/constraints/[]/kind", T::Enum, "", any(),
-                 "fixed: displacement 0 on the given axes; drained: pore pressure prescribed; "
+                 "fixed: displacement prescribed (0 unless given) on the given axes; drained: pore "
+                 "pressure prescribed; "
                  "traction: a uniform traction on the surface facets inside the region.",
                  {"fixed", "drained", "traction"}),
         required("/porous_solids/[]/constraints/[]/region", T::Shape, "", any(),
@@ -234,6 +235,14 @@ std::vector<KeySpec> make_schema() {
             "drained only: the prescribed pore pressure."),
         key("/porous_solids/[]/constraints/[]/traction", T::Vec3, "Pa", closed(-1e12, 1e12), zero3,
             "traction only: force per area on the surface (e.g. [0, 0, -1e4] presses down)."),
+        key("/porous_solids/[]/constraints/[]/displacement", T::Vec3, "m", closed(-1e3, 1e3), zero3,
+            "fixed only: the prescribed displacement of the held components (a platen that moves "
+            "with `table`)."),
+        optional("/porous_solids/[]/constraints/[]/table", T::Table, "", closed(-1e6, 1e6),
+                 "A piecewise-linear time table [[t0, f0], [t1, f1], ...] (t in s, increasing from "
+                 "0 on) that multiplies the constraint's traction, pressure or displacement: "
+                 "constant before the first row and after the last. Absent: a factor of 1. A load "
+                 "that ramps to failure, a pressure raised in steps, a platen moved at a rate."),
 
         key("/pore_flow", T::Object, "", any(), json::object(),
             "Transport of pore water between porous particles (method.md §4.7)."),
@@ -396,6 +405,8 @@ std::string describe_type(const KeySpec& spec) {
             return "shape object";
         case ValueType::ShapeArray:
             return "non-empty array of shape objects";
+        case ValueType::Table:
+            return "non-empty array of [time, value] rows";
     }
     return "?";
 }

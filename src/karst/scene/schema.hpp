@@ -21,6 +21,7 @@ enum class ValueType {
     ObjectArray,  ///< array of objects whose keys are listed under pointer + "/[]"
     Shape,        ///< a geometry object (keys listed under "shape" and "shape:<type>")
     ShapeArray,   ///< non-empty array of geometry objects
+    Table,        ///< non-empty array of [time, value] rows, times (s) increasing from 0 on
 };
 
 /// Closed or open numeric interval for Number and Integer keys, and for every component of Vec3.

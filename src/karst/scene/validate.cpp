@@ -114,6 +114,26 @@ private:
         if (!k.range.contains(v.get<double>())) throw SceneError(path, expected, v.dump());
     }
 
+    /// Rows [time, value]: times at least 0 and strictly increasing, values in the key's range.
+    void time_table(const json& v, const KeySpec& k, const std::string& path) {
+        if (!v.is_array() || v.empty())
+            throw SceneError(path, "a non-empty array of [time, value] rows", describe_value(v));
+        KeySpec time = k;
+        time.unit = "s", time.range = Range{0, 1e12};
+        for (size_t i = 0; i < v.size(); ++i) {
+            const std::string row = fmt::format("{}/{}", path, i);
+            if (!v[i].is_array() || v[i].size() != 2)
+                throw SceneError(row, "a [time, value] row", describe_value(v[i]));
+            number(v[i][0], time, row + "/0", false);
+            number(v[i][1], k, row + "/1", false);
+            if (i > 0 && v[i][0].get<double>() <= v[i - 1][0].get<double>())
+                throw SceneError(
+                    row + "/0",
+                    fmt::format("a time after the previous row's {} s", v[i - 1][0].get<double>()),
+                    v[i][0].dump());
+        }
+    }
+
     void shape(json& v, const std::string& path) {
         if (!v.is_object()) throw SceneError(path, "a shape object", describe_value(v));
         const auto& table = children_by_parent();
@@ -166,6 +186,9 @@ private:
                 break;
             case ValueType::Shape:
                 shape(v, path);
+                break;
+            case ValueType::Table:
+                time_table(v, k, path);
                 break;
             case ValueType::ShapeArray:
                 if (!v.is_array() || v.empty())

@@ -204,7 +204,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             follow_structure_displacement(model, state);
             if (!biot_call_due(model, state)) return false;
             remesh_structures(model, state);
-            solve_structures(model, state);
+            solve_structures(model, state, t + dt);
             return true;
         });
         if (called) {
