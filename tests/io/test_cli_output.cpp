@@ -92,6 +92,46 @@ TEST(Cli, WritesCompleteOutputFolder) {
     EXPECT_GT(stats["phases"]["pressure_solve"].get<double>(), 0);
 }
 
+TEST(Cli, AFracturingRunWritesItsCracksDamageAndCounts) {
+    // A cantilever under its weight at three times its strength (tests/pfem/test_fracture_scene).
+    TempDir dir("cracks");
+    std::ofstream(dir.path / "overhang.json") << R"({
+      "name": "overhang", "particle_spacing": 0.05, "time": { "end": 0.2 },
+      "domain": { "min": [-0.5, -0.5, -3], "max": [1.5, 0.7, 0.7] }, "poroelastic": { "time_step": 0.02 },
+      "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [1.0, 0.2, 0.2] },
+        "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e7, "tensile_strength": 1e5 },
+        "constraints": [
+          { "kind": "fixed", "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+          { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } } ] } ]
+    })";
+    const fs::path out = dir.path / "out";
+    ASSERT_EQ(karst("run " + (dir.path / "overhang.json").string() + " --out " + out.string() +
+                    " --quiet"),
+              0);
+    const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
+    const auto& fracture = stats["fracture"];
+    EXPECT_GT(fracture["cracks"].get<int>(), 0);
+    EXPECT_GT(fracture["links_broken"].get<int>(), fracture["cracks"].get<int>());
+    EXPECT_GT(fracture["nodes_split"].get<int>(), 0);
+    EXPECT_GE(fracture["fragments_created"].get<int>(), 1);
+    EXPECT_EQ(stats["counts"]["fragments"].get<int>(),
+              1 + fracture["fragments_created"].get<int>());
+    EXPECT_TRUE(stats["phases"].contains("fracture"));
+    // The last frame's cracks: one 16-gon per crack, listed in run.pvd as part 4.
+    const std::string last = "cracks_0006.vtp";
+    const std::string cracks = read_text(out / last);
+    std::smatch polys;
+    const std::regex polys_count(R"re(NumberOfPolys="(\d+)")re");
+    std::regex_search(cracks, polys, polys_count);
+    ASSERT_FALSE(polys.empty());
+    EXPECT_EQ(std::stoi(polys[1]), fracture["cracks"].get<int>());
+    for (const char* array : {"\"normal\"", "\"radius\"", "\"area\"", "\"time\""})
+        EXPECT_NE(cracks.find(array), std::string::npos) << array;
+    EXPECT_NE(read_text(out / "run.pvd").find("part=\"4\" file=\"" + last + "\""),
+              std::string::npos);
+    EXPECT_NE(read_text(out / "porous_0006.vtp").find("Name=\"damage\""), std::string::npos);
+}
+
 TEST(Cli, BadSceneExitsWithTwoAndWritesNothing) {
     TempDir dir("cli_bad");
     std::string bad = k_tiny;

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <numbers>
 #include <regex>
 
 namespace karst {
@@ -17,7 +19,7 @@ FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings)
     fs::create_directories(m_dir);
     // Frames of an earlier, longer run would otherwise sit beside this run's.
     static const std::regex ours(
-        R"((fluid_\d+\.(vtp|ply)|mesh_\d+\.vtu|porous_\d+\.vtp|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
+        R"((fluid_\d+\.(vtp|ply)|mesh_\d+\.vtu|(porous|cracks)_\d+\.vtp|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
     for (const auto& entry : fs::directory_iterator(m_dir))
         if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours))
             fs::remove(entry.path());
@@ -63,10 +65,15 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
     if (parts.porous && m_settings.vtp)
         write_file_atomically(m_dir / fmt::format("porous_{:04d}.vtp", frame),
                               vtp_bytes(*parts.porous));
-    m_written.push_back({parts.fluid != nullptr, parts.mesh != nullptr, parts.porous != nullptr});
+    const bool cracks = parts.cracks && !parts.cracks->polygons.empty();
+    if (cracks && m_settings.vtp)
+        write_file_atomically(m_dir / fmt::format("cracks_{:04d}.vtp", frame),
+                              vtp_polygons_bytes(parts.cracks->vertices, parts.cracks->polygons));
+    m_written.push_back(
+        {parts.fluid != nullptr, parts.mesh != nullptr, parts.porous != nullptr, cracks});
 
     if (m_settings.vtp) {
-        // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles.
+        // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles, 4 cracks.
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {
             if (m_written[f].fluid)
@@ -76,6 +83,8 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
                 entries.push_back({m_log[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
             if (m_written[f].porous)
                 entries.push_back({m_log[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
+            if (m_written[f].cracks)
+                entries.push_back({m_log[f].time, 4, fmt::format("cracks_{:04d}.vtp", f)});
         }
         write_file_atomically(m_dir / "run.pvd", pvd_bytes(entries));
     }
@@ -91,6 +100,32 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
             r.kinetic_energy + r.potential_energy);
     }
     write_file_atomically(m_dir / "log.csv", csv);
+}
+
+CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
+    constexpr int k_sides = 16;
+    CrackFrame frame;
+    std::vector<Vec3> normal;
+    std::vector<Real> radius, area, time;
+    for (const CrackRecord& c : cracks) {
+        // Two unit vectors spanning the crack plane.
+        const Vec3 a = c.normal.unitOrthogonal(), b = c.normal.cross(a);
+        std::vector<Index> polygon;
+        for (int k = 0; k < k_sides; ++k) {
+            const Real angle = 2 * std::numbers::pi * k / k_sides;
+            polygon.push_back(Index(frame.vertices.x.size()));
+            frame.vertices.x.push_back(c.centre +
+                                       c.radius * (std::cos(angle) * a + std::sin(angle) * b));
+            normal.push_back(c.normal), radius.push_back(c.radius), area.push_back(c.area),
+                time.push_back(c.time);
+        }
+        frame.polygons.push_back(std::move(polygon));
+    }
+    frame.vertices.add_vector("normal", normal);
+    frame.vertices.add_scalar("radius", radius);
+    frame.vertices.add_scalar("area", area);
+    frame.vertices.add_scalar("time", time);
+    return frame;
 }
 
 void FrameWriter::write_stats(const nlohmann::json& stats) const {

@@ -36,11 +36,21 @@ struct MeshFrame {
     std::vector<std::array<Index, 4>> tets;
 };
 
+/// Crack disks as polygons (method.md §5.5), their values on every vertex.
+struct CrackFrame {
+    PointSet vertices;
+    std::vector<std::vector<Index>> polygons;
+};
+
+/// Every crack made so far as a 16-gon in its plane: normal, radius, area (M26) and time.
+CrackFrame crack_frame(const std::vector<CrackRecord>& cracks);
+
 /// What a frame holds; absent parts are not written.
 struct FrameParts {
     const FluidParticles* fluid = nullptr;
     const MeshFrame* mesh = nullptr;
-    const PointSet* porous = nullptr;  ///< porous particles with their pore state
+    const PointSet* porous = nullptr;    ///< porous particles with their pore state
+    const CrackFrame* cracks = nullptr;  ///< written once some crack exists
 };
 
 class FrameWriter {
@@ -48,8 +58,8 @@ public:
     /// Creates `dir` and removes frame files a previous run left there.
     FrameWriter(std::filesystem::path dir, const OutputSettings& settings);
     void write_boundary(const WallParticles& walls);
-    /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu and porous_NNNN.vtp as present, then run.pvd and
-    /// log.csv anew.
+    /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu, porous_NNNN.vtp and cracks_NNNN.vtp as present, then
+    /// run.pvd and log.csv anew.
     void write_frame(const FrameParts& parts, const FrameLog& log);
     void write_stats(const nlohmann::json& stats) const;
     int frames() const { return int(m_log.size()); }
@@ -61,7 +71,7 @@ private:
     bool m_has_boundary = false;
     std::vector<FrameLog> m_log;
     struct Written {
-        bool fluid, mesh, porous;
+        bool fluid, mesh, porous, cracks;
     };
     std::vector<Written> m_written;  ///< which parts each frame has
 };

@@ -105,6 +105,44 @@ std::string vtp_bytes(const PointSet& points) {
                   blob);
 }
 
+std::string vtp_polygons_bytes(const PointSet& points,
+                               const std::vector<std::vector<Index>>& polygons) {
+    std::string blob;
+    const auto [point_data, points_offset] = append_points(blob, points);
+    std::vector<std::int64_t> conn, offsets;
+    for (const auto& polygon : polygons) {
+        conn.insert(conn.end(), polygon.begin(), polygon.end());
+        offsets.push_back(std::int64_t(conn.size()));
+    }
+    const size_t conn_offset = blob.size();
+    append_block(blob, conn);
+    const size_t offsets_offset = blob.size();
+    append_block(blob, offsets);
+    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
+                              "<VTKFile type=\"PolyData\" version=\"1.0\" "
+                              "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                              "  <PolyData>\n"
+                              "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"0\" "
+                              "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{1}\">\n"
+                              "      <PointData>\n{2}      </PointData>\n"
+                              "      <Points>\n"
+                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                              "format=\"appended\" offset=\"{3}\"/>\n"
+                              "      </Points>\n"
+                              "      <Polys>\n"
+                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+                              "format=\"appended\" offset=\"{4}\"/>\n"
+                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
+                              "format=\"appended\" offset=\"{5}\"/>\n"
+                              "      </Polys>\n"
+                              "    </Piece>\n"
+                              "  </PolyData>\n"
+                              "  <AppendedData encoding=\"raw\">\n   _",
+                              points.x.size(), polygons.size(), point_data, points_offset,
+                              conn_offset, offsets_offset),
+                  blob);
+}
+
 std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets) {
     std::string blob;
     const auto [point_data, points_offset] = append_points(blob, points);

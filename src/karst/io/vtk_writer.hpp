@@ -12,6 +12,11 @@ namespace karst {
 /// the points. Positions and float arrays are Float32, integer arrays Int64.
 std::string vtp_bytes(const PointSet& points);
 
+/// VTK XML PolyData (.vtp) of polygons over the points (each a list of point indices), with
+/// the point arrays.
+std::string vtp_polygons_bytes(const PointSet& points,
+                               const std::vector<std::vector<Index>>& polygons);
+
 /// VTK XML UnstructuredGrid (.vtu) of tetrahedra, appended raw binary, with the point arrays.
 std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets);
 

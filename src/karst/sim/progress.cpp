@@ -20,11 +20,14 @@ void ProgressLine::update(const ProgressInfo& p, bool force) {
         p.absorbed_kg >= 0 ? fmt::format("  absorbed {:.4g} kg", p.absorbed_kg) : "";
     const std::string removed =
         p.removed > 0 ? fmt::format(" ({} left the domain)", p.removed) : "";
+    const std::string fragments =
+        p.fragments > 0 ? fmt::format("  {} fragment{}", p.fragments, p.fragments > 1 ? "s" : "")
+                        : "";
     const std::string line = fmt::format(
-        "frame {:4d}  t {:8.4f}/{:.4g} s  {:7.1f} steps/s  {:6.3f} MIPPS  {} particles{}{}  ETA "
-        "{:d}:{:02d}:{:02d}",
+        "frame {:4d}  t {:8.4f}/{:.4g} s  {:7.1f} steps/s  {:6.3f} MIPPS  {} particles{}{}{}  "
+        "ETA {:d}:{:02d}:{:02d}",
         p.frame, p.time, p.end_time, p.steps_per_second, p.mipps, p.particles, removed, absorbed,
-        eta / 3600, eta / 60 % 60, eta % 60);
+        fragments, eta / 3600, eta / 60 % 60, eta % 60);
     if (m_tty) {
         fmt::print(stderr, "\r{}\x1b[K", line);
         m_dirty = true;

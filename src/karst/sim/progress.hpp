@@ -16,6 +16,7 @@ struct ProgressInfo {
     long long particles = 0;
     double absorbed_kg = -1;  ///< water soaked into porous solids so far; < 0: no porous solids
     long long removed = 0;    ///< fluid particles that left the domain so far
+    long long fragments = 0;  ///< rigid fragments with mass (0: no porous solids)
 };
 
 class ProgressLine {

@@ -74,7 +74,14 @@ PointSet porous_frame(const Model& model, const State& state) {
     NeighbourLists pairs;
     sort_into_cells(model.porous_grid, p.x, cells);
     find_neighbours(model.porous_grid, p.x, cells, true, pairs);
-    return porous_points(p, model.pore_laws, pairs, model.h);
+    PointSet points = porous_points(p, model.pore_laws, pairs, model.h);
+    // Links broken on faces through each particle (§5.6): where the rock is cracked.
+    const std::vector<Index>& damage = state.structures.damage;
+    std::vector<std::int64_t> broken(p.size(), 0);
+    for (Index i = 0; i < p.size(); ++i)
+        if (size_t(p.id[i]) < damage.size()) broken[i] = damage[p.id[i]];
+    points.add_integer("damage", broken);
+    return points;
 }
 
 }  // namespace
@@ -135,8 +142,9 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         if (porous) porous_points = porous_frame(model, state);
         MeshFrame mesh;
         if (meshes) append_structure_meshes(model, state, mesh);
+        const CrackFrame cracks = crack_frame(state.structures.cracks);
         out.write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr,
-                         porous ? &porous_points : nullptr},
+                         porous ? &porous_points : nullptr, &cracks},
                         log);
     };
 
@@ -259,7 +267,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                              particle_steps / std::max(elapsed, 1e-9) / 1e6,
                              (end - state.time) / std::max(rate, 1e-12),
                              fluid_frames ? state.fluid.size() : state.porous.size(),
-                             porous ? state.porous.absorbed : -1.0, state.removed});
+                             porous ? state.porous.absorbed : -1.0, state.removed,
+                             porous ? live_fragments(state) : 0});
         }
     } catch (const WatchdogError& e) {
         progress.finish();
