@@ -243,5 +243,39 @@ TEST(FractureScene, RaisingThePorePressureAloneCracksWhenBTimesPReachesTheStreng
     EXPECT_LE(t, 1.05);
 }
 
+TEST(FractureScene, ThreePointBendingCracksAtTheBottomOfMidSpanNearTheBeamTheoryLoad) {
+    // Mesh extent: x 0.01..1.09, b = 0.08 (y), h = 0.18 (z); rollers (z held) under x = 0.05 and
+    // x = 1.05 (span L = 1); a line load over x 0.53..0.57 on top rises by 1 % of the beam
+    // theory's cracking load F = 2 sigma_t b h^2 / (3 L) per call.
+    const Real b = 0.08, h = 0.18, L = 1.0, sigma_t = 1e5, F = 2 * sigma_t * b * h * h / (3 * L);
+    const Real strip = 0.04 * b, traction = F / strip;
+    test::Simulation sim(fmt::format(R"({{
+      "name": "three_point_bending", "particle_spacing": 0.02, "gravity": [0, 0, 0],
+      "poroelastic": {{ "time_step": 0.01 }},
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [1.1, 0.1, 0.2] }},
+        "material": {{ "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e7, "tensile_strength": {} }},
+        "constraints": [
+          {{ "kind": "drained", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] }} }},
+          {{ "kind": "fixed", "axes": "z", "region": {{ "type": "box", "min": [0.0499, -1, -1], "max": [0.0501, 2, 0] }} }},
+          {{ "kind": "fixed", "axes": "z", "region": {{ "type": "box", "min": [1.0499, -1, -1], "max": [1.0501, 2, 0] }} }},
+          {{ "kind": "traction", "traction": [0, 0, {}], "table": [[0, 0], [2, 2]],
+             "region": {{ "type": "box", "min": [0.535, -1, 0.2], "max": [0.565, 2, 1] }} }} ] }} ]
+    }})",
+                                     sigma_t, -traction));
+    // The loaded strip is what the test assumes.
+    const Structure& s0 = sim.state.structures.structures.at(0);
+    const BiotProblem& problem = sim.state.biot_cache.find(0, s0.mesh_version)->solver->problem();
+    Vec3 total = Vec3::Zero();
+    for (const Vec3& f : problem.nodal_force) total += f;
+    ASSERT_NEAR(total[2], 0, 1e-9);  // the table starts at 0
+    const Real t = first_crack_time(sim, 2);
+    ASSERT_GT(t, 0) << "no crack at twice the beam theory's load";
+    EXPECT_NEAR(t, 1, 0.1) << "cracking load / F";
+    const CrackRecord& first = sim.state.structures.cracks[0];
+    EXPECT_NEAR(first.centre[0], 0.55, 0.05);
+    EXPECT_LT(first.centre[2], 0.05) << "at the bottom";
+    EXPECT_GT(std::abs(first.normal[0]), std::cos(10 * std::numbers::pi / 180)) << "vertical";
+}
+
 }  // namespace
 }  // namespace karst

@@ -1,5 +1,6 @@
 #pragma once
-// Stresses at the nodes (method.md §5.5): volume-weighted averages of the element values.
+// Stresses at the nodes (method.md §5.5): the element strains recovered at the nodes by a
+// linear patch fit (nodal_stress.cpp says why), eps_v as the volume-weighted average.
 #include "karst/pfem/biot.hpp"
 
 namespace karst {
