@@ -18,6 +18,13 @@ namespace {
 
 constexpr Real k_strength = 1e5, k_dx = 0.1;
 
+CrackSettings settings(Real strength) {
+    CrackSettings s;
+    s.tensile_strength = strength, s.fracture_energy = 10, s.spacing = k_dx;
+    s.exclusion = 2 * k_dx, s.max_cracks = 8;
+    return s;
+}
+
 /// A box sample [0, size] on a lattice of spacing k_dx, turned by `turn` about the origin,
 /// solved as a free, drained Biot body with pore pressure `p` and the tractions of `stress`
 /// (given in the box's own frame) on its six faces.
@@ -60,8 +67,7 @@ struct Sample {
     std::vector<Crack> cracks() const {
         std::vector<Index> ids(mesh.node_count());
         for (Index a = 0; a < mesh.node_count(); ++a) ids[a] = a;
-        const CrackSettings settings{k_strength, 10, k_dx, 2 * k_dx, 8};
-        return find_cracks(mesh, stress, ids, settings);
+        return find_cracks(mesh, stress, ids, settings(k_strength));
     }
 };
 
@@ -130,12 +136,37 @@ TEST(Cracks, CrackRadiusComesFromTheStrainEnergyOverGc) {
     std::vector<Index> ids(s.mesh.node_count());
     for (Index a = 0; a < s.mesh.node_count(); ++a) ids[a] = a;
     for (Real Gc : {1e-4, 1.0, 1e4}) {
-        const auto cracks = find_cracks(s.mesh, s.stress, ids, {k_strength, Gc, k_dx, 0.2, 8});
+        CrackSettings with_gc = settings(k_strength);
+        with_gc.fracture_energy = Gc;
+        const auto cracks = find_cracks(s.mesh, s.stress, ids, with_gc);
         ASSERT_FALSE(cracks.empty());
         const Crack& c = cracks[0];
         EXPECT_NEAR(c.area, s.stress.strain_energy[c.node] / Gc, 1e-12 * c.area);
         EXPECT_NEAR(c.radius,
                     std::clamp(std::sqrt(c.area / std::numbers::pi), 0.5 * k_dx, 3 * k_dx), 1e-15);
+    }
+}
+
+TEST(Cracks, LayeredRockSplitsAlongItsWeakLayers) {
+    // A bar pulled along x, its bedding normal 30 degrees off x: sigma_nn = 0.75 sigma. With half
+    // the strength across the layers, a crack along a layer opens from sigma = 2/3 sigma_t.
+    const Real a = std::numbers::pi / 6;
+    const Vec3 normal(std::cos(a), std::sin(a), 0);
+    auto layered_cracks = [&](Real load) {
+        const Sample s(Vec3(1.2, 0.3, 0.3), Mat3::Identity(), uniaxial(load));
+        CrackSettings layered = settings(k_strength);
+        layered.strength_across = 0.5 * k_strength;
+        layered.layer_normal.assign(s.mesh.node_count(), normal);
+        std::vector<Index> ids(s.mesh.node_count());
+        for (Index k = 0; k < s.mesh.node_count(); ++k) ids[k] = k;
+        return find_cracks(s.mesh, s.stress, ids, layered);
+    };
+    EXPECT_TRUE(layered_cracks(0.95 * 2.0 / 3 * k_strength).empty());
+    const auto cracks = layered_cracks(1.05 * 2.0 / 3 * k_strength);
+    ASSERT_FALSE(cracks.empty());
+    for (const Crack& c : cracks) {
+        EXPECT_LT(angle_deg(c.normal, normal), 1e-6);
+        EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
     }
 }
 

@@ -31,13 +31,18 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                                const std::function<bool(const Crack&)>& accept) {
     std::vector<Crack> candidates;
     for (Index a = 0; a < mesh.node_count(); ++a) {
-        const Real ratio = stress.principal[a][0] / settings.tensile_strength;
+        Real ratio = stress.principal[a][0] / settings.tensile_strength;
+        Vec3 n = stress.principal_direction[a].normalized();
+        if (!settings.layer_normal.empty()) {
+            const Vec3& m = settings.layer_normal[a];
+            const Real across = m.dot(stress.effective[a] * m) / settings.strength_across;
+            if (across > ratio) ratio = across, n = m;
+        }
         if (!(ratio > 1)) continue;
         Crack c;
         c.node = a, c.centre = mesh.nodes[a], c.stress_ratio = ratio;
         // The eigenvector's sign is arbitrary: fix it so that the disk does not depend on the
         // eigen solver's choice (its largest component positive).
-        Vec3 n = stress.principal_direction[a].normalized();
         Index k;
         n.cwiseAbs().maxCoeff(&k);
         c.normal = n[k] < 0 ? Vec3(-n) : n;

@@ -25,12 +25,17 @@ struct CrackSettings {
     Real spacing = 0.02;          ///< dx, m
     Real exclusion = 0.04;        ///< no two cracks of one call closer than this (h), m
     int max_cracks = 8;           ///< N_crack per call
+    /// Weak bedding planes: per node the unit normal of the layering, and the tensile strength
+    /// across the layers (a crack along a layer opens when n . sigma' n exceeds it). Empty: none.
+    std::vector<Vec3> layer_normal;
+    Real strength_across = 1e5;  ///< Pa
 };
 
-/// M25: nodes whose largest effective principal stress exceeds sigma_t, in decreasing
-/// sigma'_1 / sigma_t (ties by the node's particle id, so the order of the particles does not
-/// matter), skipping nodes within `exclusion` of a crack already taken and cracks for which
-/// `accept` (when given) is false, at most `max_cracks`.
+/// M25: nodes whose largest effective principal stress exceeds sigma_t (or, with weak layers,
+/// whose normal stress across the layers exceeds the strength across them: a crack along the
+/// layer, whichever ratio is larger), in decreasing stress ratio (ties by the node's particle id,
+/// so the order of the particles does not matter), skipping nodes within `exclusion` of a crack
+/// already taken and cracks for which `accept` (when given) is false, at most `max_cracks`.
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                                std::span<const Index> node_id, const CrackSettings& settings,
                                const std::function<bool(const Crack&)>& accept = {});

@@ -7,7 +7,10 @@
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/rigid/fragment_motion.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace karst {
@@ -17,6 +20,11 @@ namespace {
 /// §5.6: copies sit this fraction of a spacing apart, so that a later Delaunay sees no
 /// coincident points.
 constexpr Real k_split_offset = 0.05;
+
+/// [D] The smallest piece a crack may cut off, in tets: four lattice cells (a cell holds six).
+/// Single tets chipped off by crossing crack disks became fragments of four particles that the
+/// fluid blew out of the scene.
+constexpr Index k_min_piece_tets = 24;
 
 /// The shared face's nodes of a link.
 std::vector<Index> shared_nodes(const TetMesh& mesh, const ElementLink& l) {
@@ -57,6 +65,17 @@ Fragment free_fragment(PorousParticles& p, const std::vector<Index>& members, Re
     return f;
 }
 
+/// The bedding normal at each node, from its tensor K0 (M12): the axis whose permeability is the
+/// odd one out (the smallest when k along the layers exceeds k across, else the largest).
+std::vector<Vec3> layer_normals(const std::vector<Mat3>& tensors, Real ratio) {
+    std::vector<Vec3> normal(tensors.size(), Vec3::UnitZ());
+    for (size_t a = 0; a < tensors.size(); ++a) {
+        const Eigen::SelfAdjointEigenSolver<Mat3> eigen(tensors[a]);  // ascending
+        normal[a] = eigen.eigenvectors().col(ratio >= 1 ? 0 : 2);
+    }
+    return normal;
+}
+
 /// Cracks structure `slot`; returns true when its mesh changed.
 bool fracture_structure(const Model& model, State& state, size_t slot, Real time) {
     StructureState& st = state.structures;
@@ -67,23 +86,38 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
 
     NodalStress stress = nodal_stress(s.mesh, problem.material, s.fields);
-    for (Index a = 0; a < s.mesh.node_count(); ++a)  // a node whose particle is gone: no crack
-        if (index_of[s.node_id[a]] < 0)
+    // No crack starts at a node whose particle is gone, nor at an anchored node: the stress there
+    // is the concentration of an idealised clamp, and a crack through the clamped layer would
+    // leave both halves held.
+    for (Index a = 0; a < s.mesh.node_count(); ++a)
+        if (index_of[s.node_id[a]] < 0 || problem.fixed[a])
             stress.principal[a][0] = -std::numeric_limits<Real>::infinity();
-    const CrackSettings settings{material.tensile_strength, material.fracture_energy, model.dx,
-                                 model.h, model.scene.fracture.max_cracks_per_call};
+    CrackSettings settings;
+    settings.tensile_strength = material.tensile_strength;
+    settings.fracture_energy = material.fracture_energy;
+    settings.spacing = model.dx, settings.exclusion = model.h;
+    settings.max_cracks = model.scene.fracture.max_cracks_per_call;
+    if (material.strength_across) {
+        settings.strength_across = *material.strength_across;
+        settings.layer_normal = layer_normals(s.node_tensors, material.layering_ratio);
+    }
     // A crack whose disk cuts no unbroken link (the crack is already there) does not count.
     const auto cuts_something = [&](const Crack& c) {
         const std::vector<Index> cut = links_cut(s.mesh, s.links, std::span(&c, 1));
         return std::any_of(cut.begin(), cut.end(), [](Index k) { return k >= 0; });
     };
     std::vector<Crack> cracks = find_cracks(s.mesh, stress, s.node_id, settings, cuts_something);
-    if (cracks.empty()) return false;
     const std::vector<Index> cutter = links_cut(s.mesh, s.links, cracks);
     std::vector<Index> links_broken(cracks.size(), 0);
     std::vector<char> cut(cutter.size(), 0);
+    for (size_t k = 0; k < cutter.size(); ++k) cut[k] = cutter[k] >= 0;
+    spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets);
+    // §5.1.3's sliver volume, 1e-3 h_e^3 with h_e = dx.
+    cut_sliver_bridges(s.mesh, s.links, cut, 1e-3 * std::pow(model.dx, 3));
+    // Last, so that no cut above leaves a piece under the resolution.
+    spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets);
     for (size_t k = 0; k < cutter.size(); ++k)
-        if (cutter[k] >= 0) cut[k] = 1, ++links_broken[cutter[k]];
+        if (cut[k] && cutter[k] >= 0) ++links_broken[cutter[k]];
     const Index broken = Index(std::count(cut.begin(), cut.end(), 1));
     if (broken == 0) return false;
 
@@ -116,6 +150,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         st.paired_scale[node_id[k]] = st.paired_scale[parent];
         st.rest_volume[node_id[k]] = st.rest_volume[parent];
         st.paired_volume[node_id[k]] = st.paired_volume[parent];
+        st.impulse[node_id[k]] = st.impulse[parent];
     }
     const std::vector<Index> particle = index_by_id(p, st.node_of.size());
     for (Index k = 0; k < n_new; ++k) {
@@ -123,7 +158,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         const Vec3 move = split.mesh.nodes[k] - s.mesh.nodes[a];
         const Real share = split.share[k];
         st.rest_x[id] = split.mesh.nodes[k], st.u[id] = s.fields.u[a];
-        st.rest_volume[id] *= share, st.paired_volume[id] *= share;
+        st.rest_volume[id] *= share, st.paired_volume[id] *= share, st.impulse[id] *= share;
         if (i < 0) continue;
         p.x[i] += move;
         p.volume[i] *= share, p.absorbed_mass[i] *= share, p.solid_mass[i] *= share;

@@ -136,6 +136,10 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
             for (Index& node : out.mesh.tets[e])
                 if (node == a) node = copy[g];
         }
+        // A group of interior slivers alone (tets of next to no volume) still gets a share of
+        // at least 1e-3, so that no particle is left with no volume.
+        const Real largest = *std::max_element(volume.begin(), volume.end());
+        for (Real& v : volume) v = std::max(v, 1e-3 * largest);
         const Real total = std::accumulate(volume.begin(), volume.end(), Real(0));
         Vec3 mean = Vec3::Zero();
         moves.assign(roots.size(), Vec3::Zero());
@@ -144,7 +148,23 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
             if (side[g].norm() > 0) moves[g] = offset * side[g].normalized();
             mean += out.share[copy[g]] * moves[g];
         }
-        for (size_t g = 0; g < roots.size(); ++g) out.mesh.nodes[copy[g]] += moves[g] - mean;
+        // Shorter moves where the full ones would flatten a tet around the node to under half
+        // its volume (a thin tet can turn inside out by a twentieth of a spacing); the same
+        // factor for every copy keeps the share-weighted sum zero.
+        const Vec3 base = mesh.nodes[a];
+        for (Real f = 1;; f *= 0.5) {
+            if (f < 1.0 / 64) f = 0;
+            for (size_t g = 0; g < roots.size(); ++g)
+                out.mesh.nodes[copy[g]] = base + f * (moves[g] - mean);
+            bool flattened = false;
+            for (Index k = start[a]; k < start[a + 1] && !flattened; ++k) {
+                const Tet& t = out.mesh.tets[around[k]];
+                const Real v = signed_volume(out.mesh.nodes[t[0]], out.mesh.nodes[t[1]],
+                                             out.mesh.nodes[t[2]], out.mesh.nodes[t[3]]);
+                flattened = v < 0.5 * mesh.tet_volume(around[k]);
+            }
+            if (!flattened || f == 0) break;
+        }
     }
 
     out.mesh.boundary = boundary_faces(out.mesh.tets);
@@ -160,6 +180,52 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
         out.component[e] = number[root];
     }
     return out;
+}
+
+Index cut_sliver_bridges(const TetMesh& mesh, std::span<const ElementLink> links,
+                         std::vector<char>& cut, Real min_volume) {
+    const Index ne = mesh.tet_count();
+    std::vector<char> sliver(ne);
+    for (Index e = 0; e < ne; ++e) sliver[e] = mesh.tet_volume(e) < min_volume;
+    DisjointSets solid(ne);
+    for (size_t k = 0; k < links.size(); ++k)
+        if (!cut[k] && !sliver[links[k].a] && !sliver[links[k].b])
+            solid.join(links[k].a, links[k].b);
+    // Each sliver joins the piece of its first uncut solid neighbour (links are sorted).
+    std::vector<Index> piece(ne, -1);
+    for (size_t k = 0; k < links.size(); ++k) {
+        if (cut[k]) continue;
+        const auto [a, b] = links[k];
+        if (sliver[a] && !sliver[b] && piece[a] < 0) piece[a] = solid.find(b);
+        if (sliver[b] && !sliver[a] && piece[b] < 0) piece[b] = solid.find(a);
+    }
+    Index added = 0;
+    for (size_t k = 0; k < links.size(); ++k) {
+        if (cut[k]) continue;
+        const auto [a, b] = links[k];
+        const Index pa = sliver[a] ? piece[a] : solid.find(a);
+        const Index pb = sliver[b] ? piece[b] : solid.find(b);
+        if (pa >= 0 && pb >= 0 && pa != pb) cut[k] = 1, ++added;
+    }
+    return added;
+}
+
+Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
+                         std::vector<char>& cut, Index min_tets) {
+    Index restored = 0;
+    for (bool changed = true; changed;) {
+        changed = false;
+        DisjointSets sets(tet_count);
+        for (size_t k = 0; k < links.size(); ++k)
+            if (!cut[k]) sets.join(links[k].a, links[k].b);
+        std::vector<Index> size(tet_count, 0);
+        for (Index e = 0; e < tet_count; ++e) ++size[sets.find(e)];
+        for (size_t k = 0; k < links.size(); ++k)
+            if (cut[k] &&
+                (size[sets.find(links[k].a)] < min_tets || size[sets.find(links[k].b)] < min_tets))
+                cut[k] = 0, ++restored, changed = true;
+    }
+    return restored;
 }
 
 TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loose_nodes,

@@ -26,6 +26,19 @@ struct MeshSplit {
 MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
                      std::span<const char> broken, Real offset);
 
+/// Cuts the links by which a tet of volume below `min_volume` (a sliver, with next to no
+/// stiffness) would join two pieces that are apart otherwise: the sliver goes with the piece of
+/// its first solid neighbour. A piece hanging on a sliver has a singular elasticity. Returns the
+/// number of links cut.
+Index cut_sliver_bridges(const TetMesh& mesh, std::span<const ElementLink> links,
+                         std::vector<char>& cut, Real min_volume);
+
+/// Restores cut links around every piece of fewer than `min_tets` tets that the cuts would make,
+/// until none is left: a crack does not chip off pieces below the mesh's resolution (they would
+/// be rigid fragments of a few particles). Returns the number of links restored.
+Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
+                         std::vector<char>& cut, Index min_tets);
+
 /// The tets with keep[e] set, on their nodes (renumbered in input order), and with
 /// `keep_loose_nodes` the nodes that belong to no tet: `node_of` gets, per node of the result,
 /// its index in `mesh`, and `tet_of` per tet.

@@ -200,7 +200,7 @@ void remesh_structures(const Model& model, State& state) {
     }
 }
 
-void solve_structures(const Model& model, State& state, Real time) {
+void solve_structures(const Model& model, State& state, Real time, bool again) {
     StructureState& st = state.structures;
     const PorousParticles& p = state.porous.particles;
     const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
@@ -229,14 +229,32 @@ void solve_structures(const Model& model, State& state, Real time) {
                 if (drained[a]) s.fields.p[a] = b.drained_pressure[a];
         }
         solver.set_extra_loads(loads);
-        s.u_from = s.fields.u;  // where the particles are now
+        // Where the particles are now: X + u of the last call, or short of it when this call
+        // comes early (again at once after a fracture).
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            const Index i = index_of[s.node_id[a]];
+            s.u_from[a] = i >= 0 ? Vec3(p.x[i] - st.rest_x[s.node_id[a]]) : s.fields.u[a];
+        }
         const BiotCallReport r = solver.advance(dt, s.fields);
         st.timings.factorisation += r.seconds_flow_factorisation,
             st.timings.iterations += r.seconds_iterations;
-        ++st.timings.biot_calls, st.timings.biot_iterations += r.iterations;
+        ++(again ? st.timings.repeated_calls : st.timings.biot_calls);
+        st.timings.biot_iterations += r.iterations;
         st.timings.all_converged = st.timings.all_converged && r.converged;
         s.distorted = distorted(s);
     }
+}
+
+Real largest_call_displacement(const State& state) {
+    Real largest = 0;
+    for (const Structure& s : state.structures.structures)
+        for (size_t a = 0; a < s.fields.u.size(); ++a)
+            largest = std::max(largest, (s.fields.u[a] - s.u_from[a]).norm());
+    return largest;
+}
+
+void end_biot_call(State& state) {
+    StructureState& st = state.structures;
     std::fill(st.impulse.begin(), st.impulse.end(), Vec3::Zero());
     st.elapsed = 0;
 }

@@ -43,8 +43,16 @@ void remesh_structures(const Model& model, State& state);
 
 /// One Biot call per structure over the time since the last (M22), ending at `time`: loaded by
 /// the mean force since then (§5.3) and the constraints' values at `time` (time tables), with
-/// p^n from the pore water (M5) unless the Biot pressure is carried.
-void solve_structures(const Model& model, State& state, Real time);
+/// p^n from the pore water (M5) unless the Biot pressure is carried. `again`: the call repeated
+/// at once after a fracture (counted apart).
+void solve_structures(const Model& model, State& state, Real time, bool again = false);
+
+/// The largest displacement of a node in the last call (from where its particle was), m.
+Real largest_call_displacement(const State& state);
+
+/// Ends the call: the loads summed since the last one are spent (a call repeated at once after
+/// a fracture solves the same interval under the same loads).
+void end_biot_call(State& state);
 
 /// §5.4: porosity (M23), bulk volume V0 (1 + eps_v) and permeability (M24) into the particles
 /// and the next call's mobility. Returns true when some particle's volume or permeability moved

@@ -40,6 +40,7 @@ struct Structure {
 struct PfemTimings {
     Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0;
     Index biot_calls = 0, biot_iterations = 0, remeshes = 0;
+    Index repeated_calls = 0;  ///< calls repeated at once after a fracture (sim/step.cpp)
     bool all_converged = true;
 };
 

@@ -147,6 +147,14 @@ Scene parse_scene(const std::string& text) {
         solid.angular_velocity = vec3(j["angular_velocity"]);
         mat.layering_normal = vec3(j["layering"]["normal"]),
         mat.layering_ratio = j["layering"]["ratio"];
+        if (j["layering"].contains("tensile_strength_across")) {
+            if (mat.layering == Layering::Fibre)
+                throw SceneError(solid.path + "/layering/tensile_strength_across",
+                                 "no strength across layers for fibres (bedding or "
+                                 "from_geometry only)",
+                                 j["layering"]["tensile_strength_across"].dump());
+            mat.strength_across = j["layering"]["tensile_strength_across"].get<Real>();
+        }
         if (mat.layering_normal.norm() < 1e-6)
             throw SceneError(solid.path + "/layering/normal", "a non-zero direction", "[0, 0, 0]");
         for (size_t w = 0; w < j["wet_regions"].size(); ++w)

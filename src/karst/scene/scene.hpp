@@ -73,6 +73,7 @@ struct PorousMaterial {
     Layering layering{};
     Vec3 layering_normal = Vec3::Zero();  ///< bedding normal, or fibre tangent
     Real layering_ratio{};                ///< k along / k across the layers (fibres)
+    std::optional<Real> strength_across;  ///< sigma_t across bedding planes, Pa; absent: sigma_t
     Real dissolution_porosity{};          ///< phi_diss (method.md §4.8)
     Real dissolution_saturation{};        ///< S_diss
     Real absorption_factor{};             ///< chi_abs of M15

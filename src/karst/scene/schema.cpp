@@ -210,6 +210,12 @@ std::vector<KeySpec> make_schema() {
             "Bedding-plane normal (or fibre tangent) in the solid's frame."),
         key("/porous_solids/[]/layering/ratio", T::Number, "", closed(0.01, 100), 1.0,
             "k along the layers (fibres) / k across them (1: isotropic); det K stays k0^3."),
+        optional("/porous_solids/[]/layering/tensile_strength_across", T::Number, "Pa",
+                 positive(1e12),
+                 "bedding and from_geometry only: the tensile strength across the bedding planes. "
+                 "Layered rock splits along its layers: a crack along the layer opens where the "
+                 "effective normal stress across it exceeds this (method.md M25). Absent: the "
+                 "material's tensile_strength."),
         key("/porous_solids/[]/wet_regions", T::ObjectArray, "", any(), json::array(),
             "Regions of the solid that start wet."),
         required("/porous_solids/[]/wet_regions/[]/region", T::Shape, "", any(),

@@ -55,6 +55,7 @@ nlohmann::json biot_stats(const PfemTimings& t) {
     return {{"calls", t.biot_calls},
             {"iterations", t.biot_iterations},
             {"remeshes", t.remeshes},
+            {"repeated_after_fracture", t.repeated_calls},
             {"mean_iterations", t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0},
             {"all_converged", t.all_converged}};
 }

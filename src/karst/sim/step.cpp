@@ -37,6 +37,13 @@ constexpr int k_max_step_halvings = 4;
 /// So a tolerance stricter than 1 % buys iterations, never shorter steps.
 constexpr Real k_step_density_error = 0.01;
 
+/// [D] How often a Biot call is repeated at once after a fracture (each time with up to N_crack
+/// new cracks per structure): a crack runs on while the stress at its tip stays over the
+/// strength, and a piece hanging by a neck of a few elements breaks off in the call instead of
+/// swinging metres out under a small-strain solution. Up to k_fracture_rounds always, and up to
+/// k_max_fracture_rounds while some node would move over a spacing in the call.
+constexpr int k_fracture_rounds = 4, k_max_fracture_rounds = 32;
+
 template <class F>
 auto timed(StepProfile& profile, Stage stage, const F& f) {
     Stopwatch watch;
@@ -199,7 +206,9 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         //     last call's X + u (7, elastic part); when a call is due, remesh triggers (§4.10),
         //     the Biot call on the mean loads (M22), fracture (§5.5-5.6: cracks, split nodes,
         //     new free fragments) and the feedback into the pores (§5.4).
-        //     Fracture (§5.5-5.6) tests the call's stress before the feedback reads it.
+        //     Fracture (§5.5-5.6) tests the call's stress before the feedback reads it; a
+        //     structure that cracked is solved again at once under the same loads (§4.10), and
+        //     tested again, so that a crack runs as far as the load drives it within the call.
         const bool called = timed(profile, Stage::Structure, [&] {
             follow_structure_displacement(model, state);
             if (!biot_call_due(model, state)) return false;
@@ -208,10 +217,20 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             return true;
         });
         if (called) {
-            if (timed(profile, Stage::Fracture,
-                      [&] { return fracture_structures(model, state, t + dt); }))
+            // Beyond k_fracture_rounds, only while a node would still move over a spacing in
+            // the call: a piece hanging by a neck, which small strain cannot carry.
+            for (int round = 0; round < k_max_fracture_rounds; ++round) {
+                if (round >= k_fracture_rounds && largest_call_displacement(state) <= model.dx)
+                    break;
+                if (!timed(profile, Stage::Fracture,
+                           [&] { return fracture_structures(model, state, t + dt); }))
+                    break;
                 state.porous_scratch.pairs_stale = true;
+                timed(profile, Stage::Structure,
+                      [&] { solve_structures(model, state, t + dt, true); });
+            }
             timed(profile, Stage::Structure, [&] {
+                end_biot_call(state);
                 if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
             });
         }
