@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstring>
+#include <string_view>
 
 namespace karst {
 
@@ -71,76 +72,63 @@ std::string finish(std::string head, const std::string& blob) {
 
 }  // namespace
 
-std::string vtp_bytes(const PointSet& points) {
-    const size_t n = points.x.size();
+namespace {
+
+/// PolyData of the points with one cell block (`kind`: "Verts" or "Polys"): the cells' point
+/// indices one after another, and where each cell ends.
+std::string polydata_bytes(const PointSet& points, const char* kind,
+                           const std::vector<std::int64_t>& conn,
+                           const std::vector<std::int64_t>& offsets) {
     std::string blob;
     const auto [point_data, points_offset] = append_points(blob, points);
     const size_t conn_offset = blob.size();
-    std::vector<std::int64_t> conn(n), offsets(n);
-    for (size_t i = 0; i < n; ++i) conn[i] = std::int64_t(i), offsets[i] = std::int64_t(i + 1);
     append_block(blob, conn);
     const size_t offsets_offset = blob.size();
     append_block(blob, offsets);
-    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
-                              "<VTKFile type=\"PolyData\" version=\"1.0\" "
-                              "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                              "  <PolyData>\n"
-                              "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{0}\" "
-                              "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
-                              "      <PointData>\n{1}      </PointData>\n"
-                              "      <Points>\n"
-                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
-                              "format=\"appended\" offset=\"{2}\"/>\n"
-                              "      </Points>\n"
-                              "      <Verts>\n"
-                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
-                              "format=\"appended\" offset=\"{3}\"/>\n"
-                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
-                              "format=\"appended\" offset=\"{4}\"/>\n"
-                              "      </Verts>\n"
-                              "    </Piece>\n"
-                              "  </PolyData>\n"
-                              "  <AppendedData encoding=\"raw\">\n   _",
-                              n, point_data, points_offset, conn_offset, offsets_offset),
-                  blob);
+    const bool verts = std::string_view(kind) == "Verts";
+    return finish(
+        fmt::format("<?xml version=\"1.0\"?>\n"
+                    "<VTKFile type=\"PolyData\" version=\"1.0\" "
+                    "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                    "  <PolyData>\n"
+                    "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{1}\" "
+                    "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{2}\">\n"
+                    "      <PointData>\n{3}      </PointData>\n"
+                    "      <Points>\n"
+                    "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                    "format=\"appended\" offset=\"{4}\"/>\n"
+                    "      </Points>\n"
+                    "      <{5}>\n"
+                    "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+                    "format=\"appended\" offset=\"{6}\"/>\n"
+                    "        <DataArray type=\"Int64\" Name=\"offsets\" "
+                    "format=\"appended\" offset=\"{7}\"/>\n"
+                    "      </{5}>\n"
+                    "    </Piece>\n"
+                    "  </PolyData>\n"
+                    "  <AppendedData encoding=\"raw\">\n   _",
+                    points.x.size(), verts ? offsets.size() : 0, verts ? 0 : offsets.size(),
+                    point_data, points_offset, kind, conn_offset, offsets_offset),
+        blob);
+}
+
+}  // namespace
+
+std::string vtp_bytes(const PointSet& points) {
+    std::vector<std::int64_t> conn(points.x.size()), offsets(points.x.size());
+    for (size_t i = 0; i < conn.size(); ++i)
+        conn[i] = std::int64_t(i), offsets[i] = std::int64_t(i + 1);
+    return polydata_bytes(points, "Verts", conn, offsets);
 }
 
 std::string vtp_polygons_bytes(const PointSet& points,
                                const std::vector<std::vector<Index>>& polygons) {
-    std::string blob;
-    const auto [point_data, points_offset] = append_points(blob, points);
     std::vector<std::int64_t> conn, offsets;
     for (const auto& polygon : polygons) {
         conn.insert(conn.end(), polygon.begin(), polygon.end());
         offsets.push_back(std::int64_t(conn.size()));
     }
-    const size_t conn_offset = blob.size();
-    append_block(blob, conn);
-    const size_t offsets_offset = blob.size();
-    append_block(blob, offsets);
-    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
-                              "<VTKFile type=\"PolyData\" version=\"1.0\" "
-                              "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                              "  <PolyData>\n"
-                              "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"0\" "
-                              "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{1}\">\n"
-                              "      <PointData>\n{2}      </PointData>\n"
-                              "      <Points>\n"
-                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
-                              "format=\"appended\" offset=\"{3}\"/>\n"
-                              "      </Points>\n"
-                              "      <Polys>\n"
-                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
-                              "format=\"appended\" offset=\"{4}\"/>\n"
-                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
-                              "format=\"appended\" offset=\"{5}\"/>\n"
-                              "      </Polys>\n"
-                              "    </Piece>\n"
-                              "  </PolyData>\n"
-                              "  <AppendedData encoding=\"raw\">\n   _",
-                              points.x.size(), polygons.size(), point_data, points_offset,
-                              conn_offset, offsets_offset),
-                  blob);
+    return polydata_bytes(points, "Polys", conn, offsets);
 }
 
 std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets) {
