@@ -1,6 +1,5 @@
 #include "karst/pfem/fracture_stage.hpp"
 
-#include "karst/core/timer.hpp"
 #include "karst/pfem/cracks.hpp"
 #include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/rigid_modes.hpp"
@@ -239,13 +238,11 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
 
 bool fracture_structures(const Model& model, State& state, Real time) {
     if (!model.scene.fracture.enabled) return false;
-    Stopwatch watch;
     bool changed = false;
     const size_t count = state.structures.structures.size();
     for (size_t slot = 0; slot < count; ++slot)
         changed = fracture_structure(model, state, slot, time) || changed;
     if (changed) refresh_fragment_mass(state, model.dx);
-    state.structures.fracture.seconds += watch.seconds();
     return changed;
 }
 

@@ -52,10 +52,9 @@ struct CrackRecord {
     Index links_broken = 0;
 };
 
-/// What fracture did so far (stats.json "fracture").
+/// What fracture did so far (stats.json "fracture"; its time is the step profile's "fracture").
 struct FractureCounts {
     Index cracks = 0, links_broken = 0, nodes_split = 0, fragments_created = 0;
-    Real seconds = 0;  ///< the fracture phase (Table 3's "Fracture Process")
 };
 
 struct StructureState {
