@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <exception>
+#include <optional>
 
 namespace {
 
@@ -22,12 +23,12 @@ karst::Scene read_scene(const std::string& path) {
 int main(int argc, char** argv) {
     CLI::App app{"karst: water soaking into, deforming, dissolving and breaking porous material"};
     app.set_version_flag("--version", KARST_VERSION);
-    app.require_subcommand(1);
+    app.require_subcommand(0, 1);
 
     std::string scene_path;
     karst::RunOptions run_options;
     std::string out_dir;
-    double end_time = -1, fps = -1;
+    std::optional<double> end_time, fps;
     CLI::App* run =
         app.add_subcommand("run", "Simulate a scene (the built-in dam break when none is given)");
     run->add_option("scene", scene_path, "Scene file (JSON)");
@@ -47,6 +48,10 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
+    }
+    if (app.get_subcommands().empty()) {  // `karst` alone: what it can do
+        fmt::print("{}", app.help());
+        return 0;
     }
 
     try {
@@ -71,8 +76,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (!out_dir.empty()) run_options.out_dir = out_dir;
-        if (end_time != -1) run_options.end_time = end_time;
-        if (fps != -1) run_options.fps = fps;
+        run_options.end_time = end_time, run_options.fps = fps;
         const karst::RunResult result = karst::run_simulation(read_scene(scene_path), run_options);
         if (!result.ok) {
             fmt::print(stderr, "karst: {}\nkarst: the last good frame is in {}\n", result.failure,

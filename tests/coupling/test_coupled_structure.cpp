@@ -158,7 +158,7 @@ TEST(CoupledStructure, WithTheBiotPressureCarriedTheSealedBlockHoldsTheUndrained
     test::Simulation sim(
         loaded_block_scene(1e5, R"(, "pressure_source": "biot", "max_iterations": 20)"));
     const Real load = run_and_mean_load(sim, 0.5, 0.8);
-    EXPECT_TRUE(sim.state.structures.timings.all_converged);
+    EXPECT_EQ(sim.state.structures.timings.unconverged_calls, 0);
     const BiotMaterial m = biot_material(sim.model, sim.model.scene.porous_solids[0].material);
     const Real M = 1 / m.storage, E_oed = m.lame_lambda() + 2 * m.shear_modulus();
     const Real q = load / (0.4 * 0.4);

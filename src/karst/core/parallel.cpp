@@ -1,6 +1,9 @@
 #include "karst/core/parallel.hpp"
 
 #include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <algorithm>
 
 #include <memory>
 
@@ -21,8 +24,10 @@ ThreadLimit::~ThreadLimit() {
 }
 
 int ThreadLimit::active_threads() {
-    return static_cast<int>(
-        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    // A limit above the machine's cores allows threads that the default arena never makes.
+    return static_cast<int>(std::min<size_t>(
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+        size_t(tbb::info::default_concurrency())));
 }
 
 }  // namespace karst

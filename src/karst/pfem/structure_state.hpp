@@ -40,8 +40,8 @@ struct Structure {
 struct PfemTimings {
     Real meshing = 0, assembly = 0, factorisation = 0, iterations = 0;
     Index biot_calls = 0, biot_iterations = 0, remeshes = 0;
-    Index repeated_calls = 0;  ///< calls repeated at once after a fracture (sim/step.cpp)
-    bool all_converged = true;
+    Index repeated_calls = 0;     ///< calls repeated at once after a fracture (sim/step.cpp)
+    Index unconverged_calls = 0;  ///< calls that ended at max_iterations above the tolerance
 };
 
 /// A crack disk made by fracture (method.md §5.5), in world coordinates.

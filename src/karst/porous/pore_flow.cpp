@@ -100,7 +100,7 @@ PorePairs PoreFlow::pairs(const PorousParticles& p, const NeighbourLists& candid
         Real sum = 0;
         candidates.for_each(i, [&](Index j) {
             const Real w = weight[i * cap + s++];
-            if (w == 0) return;
+            if (!(w > 0)) return;  // the count pass's test: a NaN weight is skipped by both
             const Real c = pair_conductance(p, std::min(i, j), std::max(i, j), w);
             out.other[at] = j, out.weight[at] = w, out.conductance[at++] = c, sum += c;
         });
@@ -327,6 +327,10 @@ PoreFlowReport PoreFlow::advance(PorousParticles& p, const PorePairs& neighbours
         });
         const Real limit = stiffness > 0 ? 0.5 / stiffness : remaining;
         const Real steps = std::ceil(remaining / limit - 1e-12);
+        if (report.substeps + steps > k_max_pore_substeps) {
+            report.substeps_needed = report.substeps + steps;
+            return report;
+        }
         const Real h_sub = remaining / std::max(Real(1), steps);
 
         // Donor limiter (Zalesak-style): a donor may not give more than it has this sub-step, and

@@ -11,8 +11,15 @@
 
 namespace karst {
 
+/// Explicit pore-flow sub-steps allowed in one step: more means the pore water is so stiff
+/// (pore_stiffness x mobility / h^2) that the run would crawl; it stops instead (issue 15).
+inline constexpr Real k_max_pore_substeps = 1e4;
+
 struct PoreFlowReport {
     int substeps = 0;
+    /// Sub-steps the step would need when over k_max_pore_substeps (then nothing was advanced
+    /// past the sub-steps already done); 0 otherwise.
+    Real substeps_needed = 0;
     Index limited_donors = 0;  ///< donors whose outflow the limiter scaled (summed over sub-steps)
     Real absorbed = 0;         ///< net water from fluid into porous particles, kg
     /// Per fluid particle: the porous particle that received most of its water in this step (-1

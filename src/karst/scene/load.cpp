@@ -1,10 +1,13 @@
 #include "karst/scene/scene.hpp"
+#include "karst/scene/read_json.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/scene/validate.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <stdexcept>
@@ -15,6 +18,9 @@ namespace karst {
 namespace {
 
 using json = nlohmann::json;
+
+/// Scenes are hand-written or generated descriptions, never data: 64 MB is far beyond any.
+constexpr std::uintmax_t k_max_scene_bytes = std::uintmax_t(64) << 20;
 
 Vec3 vec3(const json& v) {
     return {v[0].get<Real>(), v[1].get<Real>(), v[2].get<Real>()};
@@ -57,17 +63,18 @@ Shape read_shape(const json& j, const std::string& path) {
 }  // namespace
 
 Scene parse_scene(const std::string& text) {
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::parse_error& e) {
-        throw SceneError("", "valid JSON",
-                         fmt::format("a syntax error at byte {}: {}", e.byte, e.what()));
-    }
+    json doc = read_scene_json(text);
     validate_scene_document(doc);
 
     Scene s;
     s.name = doc["name"];
+    // The name becomes the folder out/<name>/: it must stay inside out/.
+    const bool control = std::any_of(s.name.begin(), s.name.end(),
+                                     [](char c) { return static_cast<unsigned char>(c) < 0x20; });
+    if (s.name.find_first_of("/\\") != std::string::npos ||
+        s.name.find("..") != std::string::npos || s.name == "." || control)
+        throw SceneError("/name", "a plain folder name (no '/', '\\', '..' or control characters)",
+                         doc["name"].dump());
     s.particle_spacing = doc["particle_spacing"];
     s.gravity = vec3(doc["gravity"]);
     if (doc.contains("domain")) {
@@ -221,6 +228,19 @@ Scene parse_scene(const std::string& text) {
 }
 
 Scene load_scene_file(const std::string& path) {
+    // Only a regular file: a FIFO would block the read forever, a folder reads as nothing.
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (fs::exists(status) && !fs::is_regular_file(status)) {
+        const char* kind = fs::is_directory(status) ? "a folder"
+                           : fs::is_fifo(status)    ? "a FIFO (named pipe)"
+                                                    : "not a regular file";
+        throw SceneError("", "a scene file (JSON)", fmt::format("{} at '{}'", kind, path));
+    }
+    if (fs::exists(status) && fs::file_size(path, ec) > k_max_scene_bytes)
+        throw SceneError("", fmt::format("a scene file of at most {} MB", k_max_scene_bytes >> 20),
+                         fmt::format("{} bytes at '{}'", fs::file_size(path, ec), path));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw SceneError("", "a readable scene file", fmt::format("no file at '{}'", path));
     std::stringstream ss;

@@ -59,7 +59,7 @@ std::vector<KeySpec> make_schema() {
             "CFL number lambda_v: dt <= lambda_v dx / v_max (M11)."),
         key("/time/dt_max", T::Number, "s", positive(1.0), 5e-3, "Upper clamp of the time step."),
         key("/time/dt_min", T::Number, "s", positive(1.0), 1e-7,
-            "Lower clamp of the time step; a run needing less is unstable and stops."),
+            "Smallest adaptive step: a run whose step falls below it stops with exit 1 (it is unstable or far too fast for the spacing)."),
         optional("/time/fixed_dt", T::Number, "s", positive(1.0),
                  "Fixed time step; absent: adaptive CFL step (M11)."),
 

@@ -9,6 +9,9 @@
 
 #include <fmt/ostream.h>
 
+#include <unistd.h>
+
+#include <fstream>
 #include <limits>
 #include <numeric>
 #include <unordered_map>
@@ -19,10 +22,11 @@ namespace karst {
 namespace {
 
 constexpr Real inf = std::numeric_limits<Real>::infinity();
+constexpr std::int64_t k_max_lattice_index = std::int64_t(1) << 20;  ///< 21 bits per axis
 
 /// Packs a lattice index into one key (21 bits per axis, offset so negatives fit).
 std::uint64_t lattice_key(const LatticeIndex& i) {
-    constexpr std::int64_t off = 1 << 20;
+    constexpr std::int64_t off = k_max_lattice_index;
     return std::uint64_t(i[0] + off) | std::uint64_t(i[1] + off) << 21 |
            std::uint64_t(i[2] + off) << 42;
 }
@@ -33,29 +37,98 @@ std::pair<Real, Real> wall_band(const Wall& w, Real dx) {
     return w.kind == Wall::Kind::Container ? std::pair{Real(0), t} : std::pair{-t, Real(0)};
 }
 
+/// Every sampled shape lies within k_max_lattice_index spacings of the origin, so lattice
+/// indices neither overflow nor collide in lattice_key, and counting them stays finite.
+void check_lattice_extent(const Shape& shape, Real dx, Real reach, const std::string& path) {
+    const Aabb box = shape.bounds().padded(reach);
+    const double limit = double(k_max_lattice_index - 2) * dx;
+    for (int d = 0; d < 3; ++d)
+        if (!(std::abs(box.min[d]) < limit && std::abs(box.max[d]) < limit))
+            throw SceneError(
+                path,
+                fmt::format("a shape within {:g} m of the origin on each axis "
+                            "({} spacings of {:g} m)",
+                            limit, k_max_lattice_index - 2, dx),
+                fmt::format("one reaching {:g} m on axis {}",
+                            std::abs(box.min[d]) > std::abs(box.max[d]) ? box.min[d] : box.max[d],
+                            "xyz"[d]));
+}
+
+/// Bytes this process may still take: MemAvailable of /proc/meminfo, else the physical memory.
+double available_memory_bytes() {
+    std::ifstream meminfo("/proc/meminfo");
+    std::string key;
+    double kib = 0;
+    while (meminfo >> key >> kib)
+        if (key == "MemAvailable:") return kib * 1024;
+    return double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+}
+
+/// Particles and the memory a run of them needs, estimated before anything is allocated, so a
+/// scene too large for the machine is refused instead of dying of bad_alloc mid-run.
 void check_particle_budget(const Scene& s) {
     const Real dx = s.particle_spacing;
-    double total = 0;
     for (const FluidBlock& b : s.fluid_blocks)
-        total += estimate_lattice_count(b.shape, dx, -inf, 0);
+        check_lattice_extent(b.shape, dx, 0, b.path + "/shape");
     for (const PorousSolid& p : s.porous_solids)
-        total += estimate_lattice_count(p.shape, dx, -inf, 0);
+        check_lattice_extent(p.shape, dx, 0, p.path + "/shape");
+    for (const Wall& w : s.walls)
+        check_lattice_extent(w.shape, dx, w.layers * dx, w.path + "/shape");
+    double fluid = 0, porous = 0, walls = 0;
+    for (const FluidBlock& b : s.fluid_blocks)
+        fluid += estimate_lattice_count(b.shape, dx, -inf, 0);
+    for (const PorousSolid& p : s.porous_solids)
+        porous += estimate_lattice_count(p.shape, dx, -inf, 0);
     for (const Wall& w : s.walls) {
+        if (fluid + porous + walls > k_max_particles) break;
         const auto [lo, hi] = wall_band(w, dx);
-        total += estimate_lattice_count(w.shape, dx, lo, hi);
-        if (total > k_max_particles) break;
+        walls += estimate_lattice_count(w.shape, dx, lo, hi);
     }
+    const double total = fluid + porous + walls;
     if (total > k_max_particles)
         throw SceneError(
             "/particle_spacing",
             fmt::format("a spacing giving at most {:g} million particles", k_max_particles / 1e6),
             fmt::format("{} m, which gives about {:.3g} million", dx, total / 1e6));
+    const double need =
+        k_bytes_per_sph_particle * (fluid + walls) + k_bytes_per_porous_particle * porous;
+    const double have = available_memory_bytes();
+    if (need > have)
+        throw SceneError(
+            "/particle_spacing",
+            fmt::format("a spacing whose particles fit in the {:.3g} GB of memory available",
+                        have / 1e9),
+            fmt::format("{} m: about {:.3g} million particles needing about {:.3g} GB", dx,
+                        total / 1e6, need / 1e9));
+}
+
+/// A run of more steps than this is a scene error (a step of 1e-300 s), not a long run.
+constexpr Real k_max_steps = 1e8;
+/// Frames one run may write (each is a set of files).
+constexpr Real k_max_frames = 1e5;
+
+void check_step_counts(const Scene& s) {
+    const Real end = s.time.end;
+    auto check = [&](Real step, const char* path) {
+        if (end / step > k_max_steps)
+            throw SceneError(path,
+                             fmt::format("a step of at least end / {:g} = {:.3g} s", k_max_steps,
+                                         end / k_max_steps),
+                             fmt::format("{:.3g} s", step));
+    };
+    if (s.time.fixed_dt) check(*s.time.fixed_dt, "/time/fixed_dt");
+    if (end * s.output.fps > k_max_frames)
+        throw SceneError(
+            "/output/fps",
+            fmt::format("at most {:g} frames over the {:g} s run", k_max_frames, end),
+            fmt::format("{:g} per second, {:.3g} frames", s.output.fps, end * s.output.fps));
+    if (!s.porous_solids.empty()) check(s.poroelastic.time_step, "/poroelastic/time_step");
 }
 
 /// Fluid blocks and porous solids on the scene lattice; no lattice site may be taken twice.
 void sample_fluid_and_solids(const Scene& s, Model& m) {
     const Real dx = s.particle_spacing;
-    std::unordered_map<std::uint64_t, std::string> owner;  // lattice key -> JSON path of the owner
+    std::unordered_map<std::uint64_t, const std::string*> owner;  // lattice key -> owner path
     auto sample = [&](const Shape& shape, const std::string& path, const auto& take) {
         const auto points = sample_lattice(shape, dx, -inf, 0);
         if (points.empty())
@@ -64,11 +137,11 @@ void sample_fluid_and_solids(const Scene& s, Model& m) {
                 fmt::format("a shape holding at least one particle at spacing {} m", dx),
                 "an empty shape");
         for (const LatticeIndex& p : points) {
-            const auto [it, fresh] = owner.emplace(lattice_key(p), path);
+            const auto [it, fresh] = owner.emplace(lattice_key(p), &path);
             if (!fresh)
                 throw SceneError(path + "/shape",
                                  "fluid blocks and porous solids that do not overlap",
-                                 fmt::format("an overlap with {} near {}", it->second,
+                                 fmt::format("an overlap with {} near {}", *it->second,
                                              fmt::streamed(lattice_point(p, dx).transpose())));
             take(lattice_point(p, dx));
         }
@@ -276,6 +349,7 @@ Model build_model(const Scene& scene) {
     if (scene.fluid_blocks.empty() && scene.walls.empty() && scene.porous_solids.empty())
         throw SceneError("/fluid_blocks", "at least one fluid block, porous solid or wall",
                          "an empty scene");
+    check_step_counts(scene);
     check_particle_budget(scene);
     sample_fluid_and_solids(scene, m);
     std::vector<int> wall_layers;  // per wall particle

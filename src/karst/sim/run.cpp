@@ -8,6 +8,7 @@
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/porous/porous_points.hpp"
 #include "karst/scene/scene_error.hpp"
+#include "karst/scene/schema.hpp"
 #include "karst/sim/energy.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
@@ -57,7 +58,8 @@ nlohmann::json biot_stats(const PfemTimings& t) {
             {"remeshes", t.remeshes},
             {"repeated_after_fracture", t.repeated_calls},
             {"mean_iterations", t.biot_calls ? double(t.biot_iterations) / t.biot_calls : 0.0},
-            {"all_converged", t.all_converged}};
+            {"unconverged_calls", t.unconverged_calls},
+            {"all_converged", t.unconverged_calls == 0}};
 }
 
 nlohmann::json fracture_stats(const FractureCounts& f) {
@@ -85,22 +87,29 @@ PointSet porous_frame(const Model& model, const State& state) {
     return points;
 }
 
+/// A flag that overrides a scene key obeys the key's range, and says so with the flag's name.
+Real checked_flag(const char* flag, const std::string& pointer, double value) {
+    for (const KeySpec& k : scene_schema())
+        if (k.pointer == pointer) {
+            if (!k.range.contains(value))
+                throw SceneError(
+                    flag,
+                    fmt::format("a number in {} {} (as {})", k.range.describe(), k.unit, pointer),
+                    fmt::format("{}", value));
+            return value;
+        }
+    throw std::logic_error("no schema key " + pointer);
+}
+
 }  // namespace
 
 RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     Scene scene = scene_in;
-    if (opt.end_time) {
-        if (!(*opt.end_time >= 0))
-            throw SceneError("--end-time", "a time >= 0 s", fmt::format("{}", *opt.end_time));
-        scene.time.end = *opt.end_time;
-    }
-    if (opt.fps) {
-        if (!(*opt.fps > 0))
-            throw SceneError("--fps", "a frame rate > 0", fmt::format("{}", *opt.fps));
-        scene.output.fps = *opt.fps;
-    }
-    if (opt.threads < 0)
-        throw SceneError("--threads", "a thread count >= 0", fmt::format("{}", opt.threads));
+    if (opt.end_time) scene.time.end = checked_flag("--end-time", "/time/end", *opt.end_time);
+    if (opt.fps) scene.output.fps = checked_flag("--fps", "/output/fps", *opt.fps);
+    if (!(opt.threads >= 0 && opt.threads <= k_max_threads))
+        throw SceneError("--threads", fmt::format("a thread count in [0, {}]", k_max_threads),
+                         fmt::format("{}", opt.threads));
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
@@ -117,7 +126,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     // released so far is energy the numerics made; the run says so once.
     EnergyAccount energy(mechanical_energy(model, state));
     ProgressLine progress(opt.quiet);
-    bool energy_warned = false, removed_warned = false;
+    bool energy_warned = false, removed_warned = false, biot_warned = false;
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
         log.kinetic_energy = e.kinetic, log.potential_energy = e.potential,
@@ -138,6 +147,13 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 "t = {:.4g} s: fluid left the domain: {} particles ({:.3g} kg) so far; stats.json "
                 "counts.removed has the total",
                 state.time, state.removed, state.removed * model.particle_mass));
+        }
+        if (!biot_warned && state.structures.timings.unconverged_calls > 0) {
+            biot_warned = true;
+            progress.warn(fmt::format(
+                "t = {:.4g} s: a Biot call stopped at /poroelastic/max_iterations = {} above its "
+                "tolerance; stats.json biot.unconverged_calls counts them",
+                state.time, model.scene.poroelastic.max_iterations));
         }
         PointSet porous_points;
         if (porous) porous_points = porous_frame(model, state);
@@ -161,6 +177,9 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     const MassTotals initial = mass_totals(state);
     StepProfile profile;
     Real max_density_error = 0, frame_density_error = 0;
+    // The pressure solve's tolerance: frames whose steps ended above it are counted and told.
+    const Real density_tolerance = scene.fluid.max_density_error;
+    Index frames_over_tolerance = 0;
     double particle_steps = 0, frame_particle_steps = 0, frame_step_seconds = 0;
     Stopwatch stepping;
     FluidParticles last_good;
@@ -216,6 +235,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
               {"slivers_dropped", quality.slivers_dropped},
               {"interior_slivers", quality.interior_slivers}}},
             {"max_density_error", max_density_error},
+            {"frames_over_density_tolerance", frames_over_tolerance},
             {"energy",
              {{"released", energy.released()},
               {"largest_gain", energy.largest_gain()},
@@ -255,6 +275,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
 
             const bool frame_due = state.time >= frame_time - 1e-9 * dt;
             if (frame_due) {
+                frames_over_tolerance += frame_density_error > density_tolerance;
                 write_frame(
                     {state.time, report.dt, state.steps, state.fluid.size(), frame_density_error,
                      frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
@@ -280,6 +301,12 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         out.write_stats(result.stats);
         return result;
     }
+    if (frames_over_tolerance > 0)
+        progress.warn(fmt::format(
+            "the density error exceeded /fluid/max_density_error = {:g} in {} of {} frames "
+            "(largest {:.3g}): the pressure solve stopped at max_iterations or the step was "
+            "too long; raise /fluid/max_iterations or lower /time/cfl",
+            density_tolerance, frames_over_tolerance, out.frames() - 1, max_density_error));
     progress.finish();
     result.stats = stats();
     out.write_stats(result.stats);

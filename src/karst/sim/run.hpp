@@ -10,6 +10,9 @@
 
 namespace karst {
 
+/// Most worker threads --threads accepts (TBB uses at most the machine's cores anyway).
+inline constexpr int k_max_threads = 1024;
+
 struct RunOptions {
     std::optional<std::filesystem::path> out_dir;  ///< default out/<scene name>/
     std::optional<double> end_time;                ///< s; overrides /time/end

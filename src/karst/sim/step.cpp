@@ -23,6 +23,8 @@
 #include "karst/sph/pcisph.hpp"
 #include "karst/sph/solute_diffusion.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 namespace karst {
@@ -86,6 +88,13 @@ void pore_flow_and_absorption(const Model& model, State& state, Real dt) {
                 : flow.advance(porous.particles, s.fragment_pairs, dt, &fluid);
     porous.absorbed += report.absorbed;
     porous.pore_substeps += report.substeps;
+    if (report.substeps_needed > 0)
+        throw WatchdogError(
+            k_stage_names[size_t(Stage::PoreFlow)], state.time,
+            fmt::format("the pore flow needs {:.3g} explicit sub-steps in a step of {:.3g} s (at "
+                        "most {:g}): the pore water is too stiff for its mobility (lower "
+                        "pore_stiffness or permeability, or raise darcy_viscosity)",
+                        report.substeps_needed, dt, k_max_pore_substeps));
     porous.fluid_deleted +=
         drain_fluid_particles(state.fluid, porous.particles, report.main_receiver,
                               state.scratch.fluid_fluid, model.particle_mass);
@@ -118,7 +127,14 @@ Real next_step_length(const Model& model, const State& state, Real target) {
         return step_towards(model.scene.poroelastic.time_step, state.time, target);
     }
     const Real dt = cfl_time_step(model, state);
-    if (model.scene.time.fixed_dt) return dt;
+    const TimeSettings& time = model.scene.time;
+    if (!time.fixed_dt && dt < time.dt_min)
+        throw WatchdogError("time step", state.time,
+                            fmt::format("the step fell to {:.3g} s, below /time/dt_min = {:.3g} s "
+                                        "(the flow is too fast or too stiff for the spacing)",
+                                        dt, time.dt_min));
+    // A fixed step is shortened only to end the run on its end time.
+    if (time.fixed_dt) return std::min(dt, std::max(time.end - state.time, Real(0)));
     target = std::min(target, state.time + time_to_next_biot_call(model, state));
     return std::isfinite(target) ? step_towards(dt, state.time, target) : dt;
 }
@@ -216,6 +232,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             solve_structures(model, state, t + dt);
             return true;
         });
+        if (called) check_structures(state.structures, Stage::Structure, t + dt);
         if (called) {
             // Beyond k_fracture_rounds, only while a node would still move over a spacing in
             // the call: a piece hanging by a neck, which small strain cannot carry.
@@ -228,12 +245,15 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
                 state.porous_scratch.pairs_stale = true;
                 timed(profile, Stage::Structure,
                       [&] { solve_structures(model, state, t + dt, true); });
+                check_structures(state.structures, Stage::Structure, t + dt);
             }
             timed(profile, Stage::Structure, [&] {
                 end_biot_call(state);
                 if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
             });
         }
+        check_vectors(state.porous.particles.x, state.porous.particles.id, Stage::Structure, t + dt,
+                      "porous position");
     }
 
     state.time = t + dt;

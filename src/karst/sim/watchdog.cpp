@@ -16,6 +16,13 @@ WatchdogError::WatchdogError(std::string_view stage_, std::int64_t particle_id_,
       particle_id(particle_id_),
       time(time_) {}
 
+WatchdogError::WatchdogError(std::string_view stage_, Real time_, const std::string& what)
+    : std::runtime_error(
+          fmt::format("watchdog: {} in stage '{}' (t = {:.6f} s)", what, stage_, time_)),
+      stage(stage_),
+      particle_id(-1),
+      time(time_) {}
+
 namespace {
 
 /// Index of the first bad entry, or n: the smallest bad index, whatever the thread count.
@@ -51,6 +58,14 @@ void check_scalars(const std::vector<Real>& values, const std::vector<std::int64
     if (i == n) return;
     throw WatchdogError(k_stage_names[size_t(stage)], id.empty() ? i : id[i], time,
                         fmt::format("non-finite {}", quantity));
+}
+
+void check_structures(const StructureState& structures, Stage stage, Real time) {
+    for (const Structure& s : structures.structures) {
+        std::vector<std::int64_t> ids(s.node_id.begin(), s.node_id.end());
+        check_vectors(s.fields.u, ids, stage, time, "displacement (Biot)");
+        check_scalars(s.fields.p, ids, stage, time, "pore pressure (Biot)");
+    }
 }
 
 }  // namespace karst

@@ -93,8 +93,7 @@ Real cfl_time_step(const Model& model, const State& state) {
     Real dt = t.dt_max;
     if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
     if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));
-    dt = std::min(dt, state.dt_solver_limit);
-    return std::max(dt, t.dt_min);
+    return std::min(dt, state.dt_solver_limit);
 }
 
 }  // namespace karst

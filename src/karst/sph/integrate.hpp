@@ -30,8 +30,8 @@ Real integrate_fluid(const Model& model, State& state, Real dt);
 void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged,
                                    Real dt_max);
 
-/// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max)) clamped to [dt_min, dt_max], or the
-/// scene's fixed step. v_max is the largest fluid or porous speed now; a_max that of the last step;
+/// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max), dt_max), or the scene's fixed step
+/// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now; a_max that of the last step;
 /// also at most the pressure solve's bound (update_solver_time_step_limit).
 Real cfl_time_step(const Model& model, const State& state);
 
