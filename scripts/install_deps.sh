@@ -11,6 +11,7 @@ packages=(
     libsuitesparse-dev libopenblas0-pthread   # CHOLMOD; OpenBLAS makes it 15x faster than reference BLAS
     libhypre-dev             # BoomerAMG for large Biot systems (brings Open MPI)
     nlohmann-json3-dev       # scene files
+    zlib1g-dev               # compressed VTK frames
     libcli11-dev             # command line
     libfmt-dev libspdlog-dev # messages
     libgtest-dev             # tests (CTest)

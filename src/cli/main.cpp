@@ -4,6 +4,7 @@
 #include "karst/scene/schema.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/run.hpp"
+#include "karst/sim/stop_signal.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -37,6 +38,9 @@ int main(int argc, char** argv) {
     run->add_option("--fps", fps, "Output frames per simulated second (overrides /output/fps)");
     run->add_option("--threads", run_options.threads, "Worker threads (0: all cores)");
     run->add_flag("--quiet", run_options.quiet, "No progress line");
+    run->add_flag("--overwrite", run_options.overwrite,
+                  "Write into a non-empty output folder that no karst run wrote (only karst's "
+                  "own file names are replaced)");
 
     std::string check_path;
     CLI::App* check = app.add_subcommand("check", "Validate a scene and print its particle counts");
@@ -77,7 +81,16 @@ int main(int argc, char** argv) {
         }
         if (!out_dir.empty()) run_options.out_dir = out_dir;
         run_options.end_time = end_time, run_options.fps = fps;
+        karst::catch_stop_signals();
         const karst::RunResult result = karst::run_simulation(read_scene(scene_path), run_options);
+        if (result.stop_signal) {
+            fmt::print(stderr,
+                       "karst: stopped by signal {} at t = {:.6g} s; {} has its frames "
+                       "and stats.json\n",
+                       result.stop_signal, result.stats["sim_time"].get<double>(),
+                       result.out_dir.string());
+            return 128 + result.stop_signal;
+        }
         if (!result.ok) {
             fmt::print(stderr, "karst: {}\nkarst: the last good frame is in {}\n", result.failure,
                        result.out_dir.string());

@@ -1,4 +1,4 @@
-// Fluid and porous fragments in one step (method.md §4.1-4.8, issue 3): Archimedes, a porous
+// Fluid and porous fragments in one step (docs/method.md §4.1-4.8, issue 3): Archimedes, a porous
 // box that soaks and sinks, a free fragment in vacuum, exact momentum exchange between fluid and
 // fragment, and exact water and grain balance through absorption, draining and dissolution.
 #include "support/files.hpp"
@@ -97,7 +97,7 @@ TEST(Coupling, LightPorousBoxSoaksUpWaterAndSinks) {
 }
 
 // No gravity, no fluid: a free fragment keeps its momentum, its angular momentum and its shape,
-// and its quaternion stays unit (method.md §4.5).
+// and its quaternion stays unit (docs/method.md §4.5).
 TEST(Coupling, FreeFragmentInVacuumConservesMomentumAndKeepsItsShape) {
     test::Simulation sim(R"({
       "name": "vacuum", "particle_spacing": 0.02, "gravity": [0, 0, 0],

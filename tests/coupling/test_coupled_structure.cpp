@@ -1,7 +1,7 @@
-// The Biot step inside a coupled run (method.md §5.3-5.4, §4.10, issue 4): a water layer resting
-// on an anchored soil block loads it through the fluid reactions, the block settles as a Biot
-// solve with the equivalent uniform traction on its top says, and its particles follow; a block
-// soft enough to distort its mesh is remeshed; with the Biot pressure carried, a sealed block
+// The Biot step inside a coupled run (docs/method.md §5.3-5.4, §4.10, issue 4): a water layer
+// resting on an anchored soil block loads it through the fluid reactions, the block settles as a
+// Biot solve with the equivalent uniform traction on its top says, and its particles follow; a
+// block soft enough to distort its mesh is remeshed; with the Biot pressure carried, a sealed block
 // holds the undrained pressure of its load.
 #include "support/simulate.hpp"
 

@@ -27,7 +27,7 @@ const char* k_tiny = R"({
   "time": { "end": 0.1 },
   "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.16, 0.16, 0.2] } } ],
   "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.16, 0.3] } } ],
-  "output": { "fps": 50 }
+  "output": { "fps": 50, "ply": true }
 })";
 
 struct TempDir {

@@ -1,4 +1,4 @@
-// The Biot solver (method.md §5.3): patch test, cantilever against Timoshenko, Terzaghi
+// The Biot solver (docs/method.md §5.3): patch test, cantilever against Timoshenko, Terzaghi
 // consolidation against the series solution, and fixed-stress against fixed-strain splitting.
 #include "karst/pfem/biot.hpp"
 #include "karst/pfem/box_nodes.hpp"

@@ -1,4 +1,4 @@
-// Fracture (issue 13, method.md §5.5-5.6): the Rankine test on the effective stress of solved
+// Fracture (issue 13, docs/method.md §5.5-5.6): the Rankine test on the effective stress of solved
 // Biot problems (tension, shear, compression, pore pressure alone), and node splitting along
 // broken links.
 #include "karst/pfem/box_nodes.hpp"

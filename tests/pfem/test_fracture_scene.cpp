@@ -1,5 +1,5 @@
-// Fracture inside the engine (issue 13, method.md §5.6): what a crack does to State. Mass, pore
-// water and momentum across node splits and new fragments; cracks that do not depend on the
+// Fracture inside the engine (issue 13, docs/method.md §5.6): what a crack does to State. Mass,
+// pore water and momentum across node splits and new fragments; cracks that do not depend on the
 // particle order or the thread count; an overhang that breaks off under its weight and falls.
 #include "support/files.hpp"
 #include "support/simulate.hpp"

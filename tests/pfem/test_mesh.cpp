@@ -1,4 +1,4 @@
-// The PFEM mesh (method.md §5.1): alpha shape volume, EDT joining of lattice cells, slivers.
+// The PFEM mesh (docs/method.md §5.1): alpha shape volume, EDT joining of lattice cells, slivers.
 #include "karst/pfem/box_nodes.hpp"
 #include "karst/pfem/tet_mesh.hpp"
 

@@ -1,4 +1,4 @@
-// Dynamic porosity (M23) and Kozeny-Carman permeability (M24), method.md §5.4.
+// Dynamic porosity (M23) and Kozeny-Carman permeability (M24), docs/method.md §5.4.
 #include "karst/pfem/porosity.hpp"
 
 #include <gtest/gtest.h>

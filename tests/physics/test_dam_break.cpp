@@ -1,5 +1,5 @@
 // Martin & Moyce (1952), n^2 = 2: the surge front Z = x/a against T = t sqrt(2 g / a) follows the
-// measured curve (../shared/data/martin_moyce_1952_surge_front.csv) within 10 % up to T = 3.
+// measured curve (tests/physics/martin_moyce_1952_surge_front.csv) within 10 % up to T = 3.
 #include "support/files.hpp"
 #include "support/simulate.hpp"
 

@@ -1,5 +1,5 @@
 // A water column at rest: PCISPH pressure equals rho0 g depth within 2 % below the top two
-// layers, with a density error of at most 1 % (method.md §10, issue 2).
+// layers, with a density error of at most 1 % (docs/method.md §10, issue 2).
 #include "support/simulate.hpp"
 
 #include "karst/core/parallel.hpp"

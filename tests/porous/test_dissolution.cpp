@@ -1,4 +1,4 @@
-// Dissolution (method.md §4.8): saturated, high-porosity particles become muddy fluid, with
+// Dissolution (docs/method.md §4.8): saturated, high-porosity particles become muddy fluid, with
 // water, solute (the grains) and momentum conserved exactly.
 #include "karst/core/parallel.hpp"
 #include "karst/porous/dissolution.hpp"

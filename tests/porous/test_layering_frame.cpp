@@ -1,4 +1,4 @@
-// Weighted PCA frames (method.md §6.2, M28): the layering normal of a tilted slab, and M28's
+// Weighted PCA frames (docs/method.md §6.2, M28): the layering normal of a tilted slab, and M28's
 // kernel tensor (inverse spread, unit determinant, the few-neighbour case).
 #include "karst/porous/layering_frame.hpp"
 

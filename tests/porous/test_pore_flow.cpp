@@ -1,4 +1,4 @@
-// Pore-water transport (method.md §4.7, M12-M16, M28 frame aside): diffusion of a saturation
+// Pore-water transport (docs/method.md §4.7, M12-M16, M28 frame aside): diffusion of a saturation
 // pulse against the analytic Gaussian, anisotropy along the layers under rotation, and exact
 // conservation of pore water with the limiter at work.
 #include "karst/core/parallel.hpp"
@@ -187,7 +187,7 @@ TEST(PoreFlow, SaturatedColumnRelaxesToHydrostaticPorePressure) {
     const int nz = 20;
     Block b = column(4, nz);
     PorousParticles& p = b.particles;
-    const PoreWaterLaw law;  // gravity on, method.md §8.2 defaults
+    const PoreWaterLaw law;  // gravity on, docs/method.md §8.2 defaults
     for (Index i = 0; i < p.size(); ++i) p.absorbed_mass[i] = 1.02 * 1000 * k_phi * p.volume[i];
     PoreFlow flow({law}, k_h, k_dx);
     for (int step = 0; step < 40; ++step) flow.advance(p, b.neighbours, 0.025);
@@ -254,13 +254,13 @@ TEST(PoreFlow, CapillaryWettingFrontAdvancesLikeSquareRootOfTime) {
                              << " " << fronts[3] << " m";
 }
 
-// The paper's Eq. 20 in its conservative form (method.md §9 item 7, /pore_flow/pair_flux):
+// The paper's Eq. 20 in its conservative form (docs/method.md §9 item 7, /pore_flow/pair_flux):
 // water is kept to round-off and a wet ball spreads, but the flux follows only differences of
 // m_p / V: in a uniformly wet block under gravity nothing moves, while the Darcy flux M15
 // drains the water downwards.
 TEST(PoreFlow, PaperEq20KeepsWaterButIgnoresGravityUnlikeDarcy) {
     ThreadLimit one(1);
-    PoreWaterLaw law;  // gravity on, method.md §8.2 defaults
+    PoreWaterLaw law;  // gravity on, docs/method.md §8.2 defaults
     auto uniform_block = [&](PairFlux flux, std::vector<Real>& before) {
         Block b = lattice_block(9, Mat3::Identity(), Mat3::Identity() * k_k0);
         PorousParticles& p = b.particles;

@@ -1,4 +1,4 @@
-// Contact springs between fragments (method.md §4.2): exact momentum exchange, the chosen
+// Contact springs between fragments (docs/method.md §4.2): exact momentum exchange, the chosen
 // restitution, and no force inside a fragment.
 #include "karst/rigid/contact.hpp"
 

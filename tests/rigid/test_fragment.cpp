@@ -1,4 +1,4 @@
-// Rigid fragments (method.md §4.5): mass properties of a particle box, and a free fragment in
+// Rigid fragments (docs/method.md §4.5): mass properties of a particle box, and a free fragment in
 // vacuum that keeps its momentum, angular momentum and a unit quaternion.
 #include "karst/rigid/fragment.hpp"
 

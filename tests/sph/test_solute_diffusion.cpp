@@ -1,4 +1,4 @@
-// Solute diffusion among fluid particles (method.md §4.9, M18): two half-spaces follow the erf
+// Solute diffusion among fluid particles (docs/method.md §4.9, M18): two half-spaces follow the erf
 // profile, and solute is conserved to round-off, also in a moving flow.
 #include "support/simulate.hpp"
 

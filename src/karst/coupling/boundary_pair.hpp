@@ -2,7 +2,7 @@
 // The force between a fluid particle i and a boundary particle k (a static wall or a porous
 // particle of a fragment), per unit mass of i. The fluid side and the reaction on the boundary
 // side call the same functions with the same operands, so each pair's two forces are bitwise
-// opposite and momentum passes to the fragments exactly (method.md §4.2, §4.3).
+// opposite and momentum passes to the fragments exactly (docs/method.md §4.2, §4.3).
 #include "karst/core/types.hpp"
 #include "karst/sph/kernels.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// The fluid's reactions on porous particles (method.md §4.3 end, §4.2): the last PCISPH
+// The fluid's reactions on porous particles (docs/method.md §4.3 end, §4.2): the last PCISPH
 // boundary pressure, friction and adhesion, each pair evaluated by the same function as on the
 // fluid side, so that the fragments receive exactly what the fluid lost.
 #include "karst/sim/model.hpp"

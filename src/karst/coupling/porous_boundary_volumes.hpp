@@ -1,6 +1,6 @@
 #pragma once
-// Akinci volumes of porous particles (method.md §4.1): recomputed every step, because fragments
-// move relative to each other and to the walls.
+// Akinci volumes of porous particles (docs/method.md §4.1): recomputed every step, because
+// fragments move relative to each other and to the walls.
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
-// Neighbour search for porous particles (method.md §3 step 1), all within h: fluid-porous pairs
-// for the Akinci boundary, porous-porous and porous-wall pairs for the Akinci volumes and
+// Neighbour search for porous particles (docs/method.md §3 step 1), all within h: fluid-porous
+// pairs for the Akinci boundary, porous-porous and porous-wall pairs for the Akinci volumes and
 // contacts, porous-fluid pairs for the reactions and absorption.
 //
 // [D] Absorption pairs stop at h, not at the porous kernel's longest reach (M13, 2 h for a

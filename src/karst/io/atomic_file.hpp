@@ -6,7 +6,8 @@
 
 namespace karst {
 
-/// Writes `bytes` to `path` atomically; throws std::runtime_error naming the path on failure.
+/// Writes `bytes` to `path` atomically and durably (fsync before the rename); throws
+/// std::runtime_error naming the path and the operating system's reason on failure.
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
 }  // namespace karst

@@ -1,6 +1,5 @@
 #include "karst/io/frame_writer.hpp"
 
-#include "karst/io/atomic_file.hpp"
 #include "karst/io/ply_writer.hpp"
 #include "karst/io/vtk_writer.hpp"
 
@@ -8,28 +7,19 @@
 
 #include <cmath>
 #include <numbers>
-#include <regex>
 
 namespace karst {
 
 namespace fs = std::filesystem;
 
-FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings)
-    : m_dir(std::move(dir)), m_settings(settings) {
-    fs::create_directories(m_dir);
-    // Frames of an earlier, longer run would otherwise sit beside this run's.
-    static const std::regex ours(
-        R"((fluid_\d+\.(vtp|ply)|mesh_\d+\.vtu|(porous|cracks)_\d+\.vtp|boundary\.vtp|run\.pvd|log\.csv|stats\.json)(\.tmp)?)");
-    for (const auto& entry : fs::directory_iterator(m_dir))
-        if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours))
-            fs::remove(entry.path());
-}
+FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings, bool overwrite)
+    : m_folder(std::move(dir), overwrite), m_settings(settings) {}
 
 void FrameWriter::write_boundary(const WallParticles& walls) {
     if (!m_settings.vtp || walls.size() == 0) return;
     PointSet points{walls.x, {}};
     points.add_scalar("psi", walls.psi);
-    write_file_atomically(m_dir / "boundary.vtp", vtp_bytes(points));
+    m_folder.write("boundary.vtp", vtp_bytes(points, m_settings.compress));
     m_has_boundary = true;
 }
 
@@ -52,23 +42,23 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         points.add_scalar("concentration", concentration);
         points.add_integer("id", fluid.id);
         if (m_settings.vtp)
-            write_file_atomically(m_dir / fmt::format("fluid_{:04d}.vtp", frame),
-                                  vtp_bytes(points));
+            m_folder.write(fmt::format("fluid_{:04d}.vtp", frame),
+                           vtp_bytes(points, m_settings.compress));
         if (m_settings.ply)
-            write_file_atomically(m_dir / fmt::format("fluid_{:04d}.ply", frame),
-                                  ply_bytes(points));
+            m_folder.write(fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
     }
     if (parts.mesh && m_settings.vtp)
-        write_file_atomically(m_dir / fmt::format("mesh_{:04d}.vtu", frame),
-                              vtu_bytes(parts.mesh->nodes, parts.mesh->tets));
+        m_folder.write(fmt::format("mesh_{:04d}.vtu", frame),
+                       vtu_bytes(parts.mesh->nodes, parts.mesh->tets, m_settings.compress));
     m_log.push_back(log);
     if (parts.porous && m_settings.vtp)
-        write_file_atomically(m_dir / fmt::format("porous_{:04d}.vtp", frame),
-                              vtp_bytes(*parts.porous));
+        m_folder.write(fmt::format("porous_{:04d}.vtp", frame),
+                       vtp_bytes(*parts.porous, m_settings.compress));
     const bool cracks = parts.cracks && !parts.cracks->polygons.empty();
     if (cracks && m_settings.vtp)
-        write_file_atomically(m_dir / fmt::format("cracks_{:04d}.vtp", frame),
-                              vtp_polygons_bytes(parts.cracks->vertices, parts.cracks->polygons));
+        m_folder.write(fmt::format("cracks_{:04d}.vtp", frame),
+                       vtp_polygons_bytes(parts.cracks->vertices, parts.cracks->polygons,
+                                          m_settings.compress));
     m_written.push_back(
         {parts.fluid != nullptr, parts.mesh != nullptr, parts.porous != nullptr, cracks});
 
@@ -86,7 +76,7 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
             if (m_written[f].cracks)
                 entries.push_back({m_log[f].time, 4, fmt::format("cracks_{:04d}.vtp", f)});
         }
-        write_file_atomically(m_dir / "run.pvd", pvd_bytes(entries));
+        m_folder.write("run.pvd", pvd_bytes(entries));
     }
     std::string csv =
         "frame,time,dt,steps,particles,removed,density_error,mipps,speed_p99,max_speed,kinetic_"
@@ -99,7 +89,7 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
             r.max_speed, r.kinetic_energy, r.potential_energy,
             r.kinetic_energy + r.potential_energy);
     }
-    write_file_atomically(m_dir / "log.csv", csv);
+    m_folder.write("log.csv", csv);
 }
 
 CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
@@ -128,8 +118,8 @@ CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
     return frame;
 }
 
-void FrameWriter::write_stats(const nlohmann::json& stats) const {
-    write_file_atomically(m_dir / "stats.json", stats.dump(2) + "\n");
+void FrameWriter::write_stats(const nlohmann::json& stats) {
+    m_folder.write("stats.json", stats.dump(2) + "\n");
 }
 
 }  // namespace karst

@@ -2,6 +2,7 @@
 // The output folder of a run: per-frame fluid and mesh files, the static boundary, run.pvd,
 // log.csv and stats.json. Each file is written atomically; run.pvd and log.csv are rewritten after
 // every frame, so the folder is complete and consistent whenever a run stops.
+#include "karst/io/output_folder.hpp"
 #include "karst/io/point_arrays.hpp"
 #include "karst/scene/scene.hpp"
 #include "karst/sim/model.hpp"
@@ -36,7 +37,7 @@ struct MeshFrame {
     std::vector<std::array<Index, 4>> tets;
 };
 
-/// Crack disks as polygons (method.md §5.5), their values on every vertex.
+/// Crack disks as polygons (docs/method.md §5.5), their values on every vertex.
 struct CrackFrame {
     PointSet vertices;
     std::vector<std::vector<Index>> polygons;
@@ -55,18 +56,19 @@ struct FrameParts {
 
 class FrameWriter {
 public:
-    /// Creates `dir` and removes frame files a previous run left there.
-    FrameWriter(std::filesystem::path dir, const OutputSettings& settings);
+    /// Claims `dir` (io/output_folder.hpp: the files of an earlier run there are removed; a
+    /// folder karst did not write is refused unless `overwrite`).
+    FrameWriter(std::filesystem::path dir, const OutputSettings& settings, bool overwrite);
     void write_boundary(const WallParticles& walls);
     /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu, porous_NNNN.vtp and cracks_NNNN.vtp as present, then
     /// run.pvd and log.csv anew.
     void write_frame(const FrameParts& parts, const FrameLog& log);
-    void write_stats(const nlohmann::json& stats) const;
+    void write_stats(const nlohmann::json& stats);
     int frames() const { return int(m_log.size()); }
-    const std::filesystem::path& dir() const { return m_dir; }
+    const std::filesystem::path& dir() const { return m_folder.dir(); }
 
 private:
-    std::filesystem::path m_dir;
+    OutputFolder m_folder;
     OutputSettings m_settings;
     bool m_has_boundary = false;
     std::vector<FrameLog> m_log;

@@ -2,7 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <zlib.h>
+
+#include <algorithm>
 #include <cstring>
+#include <stdexcept>
 #include <string_view>
 
 namespace karst {
@@ -30,12 +34,48 @@ void PointSet::add_symmetric_tensor(std::string name, const std::vector<Mat3>& v
 
 namespace {
 
-/// Appended-data block: UInt64 byte count, then the values.
+/// Uncompressed bytes per zlib block (VTK reads any size; larger blocks compress a little better).
+constexpr size_t k_zlib_block = 1 << 16;
+
+/// Appended-data block of `values`: raw, a UInt64 byte count then the bytes; with zlib, VTK's
+/// vtkZLibDataCompressor layout: UInt64 block count, block size, size of the last partial block
+/// (0 when full), each block's compressed size, then the compressed blocks.
 template <class T>
-void append_block(std::string& blob, const std::vector<T>& values) {
-    const std::uint64_t bytes = values.size() * sizeof(T);
-    blob.append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
-    blob.append(reinterpret_cast<const char*>(values.data()), bytes);
+void append_block(std::string& blob, const std::vector<T>& values, bool zlib) {
+    const char* bytes = reinterpret_cast<const char*>(values.data());
+    const std::uint64_t size = values.size() * sizeof(T);
+    auto put = [&](std::uint64_t v) { blob.append(reinterpret_cast<const char*>(&v), sizeof v); };
+    if (!zlib) {
+        put(size);
+        blob.append(bytes, size);
+        return;
+    }
+    const std::uint64_t blocks = (size + k_zlib_block - 1) / k_zlib_block;
+    put(blocks), put(k_zlib_block), put(size % k_zlib_block);
+    const size_t sizes_at = blob.size();
+    blob.append(blocks * sizeof(std::uint64_t), '\0');
+    for (std::uint64_t b = 0; b < blocks; ++b) {
+        const size_t begin = b * k_zlib_block,
+                     length = std::min<size_t>(k_zlib_block, size - begin);
+        uLongf packed = compressBound(uLong(length));
+        const size_t at = blob.size();
+        blob.resize(at + packed);
+        if (compress2(reinterpret_cast<Bytef*>(blob.data() + at), &packed,
+                      reinterpret_cast<const Bytef*>(bytes + begin), uLong(length),
+                      Z_DEFAULT_COMPRESSION) != Z_OK)
+            throw std::runtime_error("zlib could not compress a VTK block");
+        blob.resize(at + packed);
+        const std::uint64_t packed64 = packed;
+        std::memcpy(blob.data() + sizes_at + b * sizeof packed64, &packed64, sizeof packed64);
+    }
+}
+
+/// The VTKFile element's opening tag.
+std::string vtk_file_tag(const char* type, bool zlib) {
+    return fmt::format(
+        "<VTKFile type=\"{}\" version=\"1.0\" byte_order=\"LittleEndian\" "
+        "header_type=\"UInt64\"{}>\n",
+        type, zlib ? " compressor=\"vtkZLibDataCompressor\"" : "");
 }
 
 std::vector<float> to_float(const std::vector<double>& v) {
@@ -44,7 +84,7 @@ std::vector<float> to_float(const std::vector<double>& v) {
 
 /// Appends the point arrays and the positions to `blob`; returns the <PointData> entries and
 /// the offset of the positions block.
-std::pair<std::string, size_t> append_points(std::string& blob, const PointSet& points) {
+std::pair<std::string, size_t> append_points(std::string& blob, const PointSet& points, bool zlib) {
     std::string point_data;
     for (const PointArray& a : points.arrays) {
         point_data += fmt::format(
@@ -52,15 +92,15 @@ std::pair<std::string, size_t> append_points(std::string& blob, const PointSet& 
             "format=\"appended\" offset=\"{}\"/>\n",
             a.integer ? "Int64" : "Float32", a.name, a.components, blob.size());
         if (a.integer)
-            append_block(blob, std::vector<std::int64_t>(a.values.begin(), a.values.end()));
+            append_block(blob, std::vector<std::int64_t>(a.values.begin(), a.values.end()), zlib);
         else
-            append_block(blob, to_float(a.values));
+            append_block(blob, to_float(a.values), zlib);
     }
     const size_t points_offset = blob.size();
     std::vector<float> xyz;
     xyz.reserve(3 * points.x.size());
     for (const Vec3& x : points.x) xyz.insert(xyz.end(), {float(x[0]), float(x[1]), float(x[2])});
-    append_block(blob, xyz);
+    append_block(blob, xyz, zlib);
     return {point_data, points_offset};
 }
 
@@ -78,62 +118,62 @@ namespace {
 /// indices one after another, and where each cell ends.
 std::string polydata_bytes(const PointSet& points, const char* kind,
                            const std::vector<std::int64_t>& conn,
-                           const std::vector<std::int64_t>& offsets) {
+                           const std::vector<std::int64_t>& offsets, bool zlib) {
     std::string blob;
-    const auto [point_data, points_offset] = append_points(blob, points);
+    const auto [point_data, points_offset] = append_points(blob, points, zlib);
     const size_t conn_offset = blob.size();
-    append_block(blob, conn);
+    append_block(blob, conn, zlib);
     const size_t offsets_offset = blob.size();
-    append_block(blob, offsets);
+    append_block(blob, offsets, zlib);
     const bool verts = std::string_view(kind) == "Verts";
-    return finish(
-        fmt::format("<?xml version=\"1.0\"?>\n"
-                    "<VTKFile type=\"PolyData\" version=\"1.0\" "
-                    "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                    "  <PolyData>\n"
-                    "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{1}\" "
-                    "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{2}\">\n"
-                    "      <PointData>\n{3}      </PointData>\n"
-                    "      <Points>\n"
-                    "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
-                    "format=\"appended\" offset=\"{4}\"/>\n"
-                    "      </Points>\n"
-                    "      <{5}>\n"
-                    "        <DataArray type=\"Int64\" Name=\"connectivity\" "
-                    "format=\"appended\" offset=\"{6}\"/>\n"
-                    "        <DataArray type=\"Int64\" Name=\"offsets\" "
-                    "format=\"appended\" offset=\"{7}\"/>\n"
-                    "      </{5}>\n"
-                    "    </Piece>\n"
-                    "  </PolyData>\n"
-                    "  <AppendedData encoding=\"raw\">\n   _",
-                    points.x.size(), verts ? offsets.size() : 0, verts ? 0 : offsets.size(),
-                    point_data, points_offset, kind, conn_offset, offsets_offset),
-        blob);
+    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
+                              "{8}"
+                              "  <PolyData>\n"
+                              "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{1}\" "
+                              "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{2}\">\n"
+                              "      <PointData>\n{3}      </PointData>\n"
+                              "      <Points>\n"
+                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                              "format=\"appended\" offset=\"{4}\"/>\n"
+                              "      </Points>\n"
+                              "      <{5}>\n"
+                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
+                              "format=\"appended\" offset=\"{6}\"/>\n"
+                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
+                              "format=\"appended\" offset=\"{7}\"/>\n"
+                              "      </{5}>\n"
+                              "    </Piece>\n"
+                              "  </PolyData>\n"
+                              "  <AppendedData encoding=\"raw\">\n   _",
+                              points.x.size(), verts ? offsets.size() : 0,
+                              verts ? 0 : offsets.size(), point_data, points_offset, kind,
+                              conn_offset, offsets_offset, vtk_file_tag("PolyData", zlib)),
+                  blob);
 }
 
 }  // namespace
 
-std::string vtp_bytes(const PointSet& points) {
+std::string vtp_bytes(const PointSet& points, bool zlib) {
     std::vector<std::int64_t> conn(points.x.size()), offsets(points.x.size());
     for (size_t i = 0; i < conn.size(); ++i)
         conn[i] = std::int64_t(i), offsets[i] = std::int64_t(i + 1);
-    return polydata_bytes(points, "Verts", conn, offsets);
+    return polydata_bytes(points, "Verts", conn, offsets, zlib);
 }
 
 std::string vtp_polygons_bytes(const PointSet& points,
-                               const std::vector<std::vector<Index>>& polygons) {
+                               const std::vector<std::vector<Index>>& polygons, bool zlib) {
     std::vector<std::int64_t> conn, offsets;
     for (const auto& polygon : polygons) {
         conn.insert(conn.end(), polygon.begin(), polygon.end());
         offsets.push_back(std::int64_t(conn.size()));
     }
-    return polydata_bytes(points, "Polys", conn, offsets);
+    return polydata_bytes(points, "Polys", conn, offsets, zlib);
 }
 
-std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets) {
+std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets,
+                      bool zlib) {
     std::string blob;
-    const auto [point_data, points_offset] = append_points(blob, points);
+    const auto [point_data, points_offset] = append_points(blob, points, zlib);
     const size_t conn_offset = blob.size();
     std::vector<std::int64_t> conn, offsets;
     conn.reserve(4 * tets.size()), offsets.reserve(tets.size());
@@ -141,14 +181,13 @@ std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index
         conn.insert(conn.end(), {t[0], t[1], t[2], t[3]});
         offsets.push_back(std::int64_t(conn.size()));
     }
-    append_block(blob, conn);
+    append_block(blob, conn, zlib);
     const size_t offsets_offset = blob.size();
-    append_block(blob, offsets);
+    append_block(blob, offsets, zlib);
     const size_t types_offset = blob.size();
-    append_block(blob, std::vector<std::uint8_t>(tets.size(), 10));  // VTK_TETRA
+    append_block(blob, std::vector<std::uint8_t>(tets.size(), 10), zlib);  // VTK_TETRA
     return finish(fmt::format("<?xml version=\"1.0\"?>\n"
-                              "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
-                              "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                              "{7}"
                               "  <UnstructuredGrid>\n"
                               "    <Piece NumberOfPoints=\"{0}\" NumberOfCells=\"{1}\">\n"
                               "      <PointData>\n{2}      </PointData>\n"
@@ -168,7 +207,7 @@ std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index
                               "  </UnstructuredGrid>\n"
                               "  <AppendedData encoding=\"raw\">\n   _",
                               points.x.size(), tets.size(), point_data, points_offset, conn_offset,
-                              offsets_offset, types_offset),
+                              offsets_offset, types_offset, vtk_file_tag("UnstructuredGrid", zlib)),
                   blob);
 }
 

@@ -8,17 +8,20 @@
 
 namespace karst {
 
-/// VTK XML PolyData (.vtp), appended raw binary, with a Verts cell per point so ParaView draws
-/// the points. Positions and float arrays are Float32, integer arrays Int64.
-std::string vtp_bytes(const PointSet& points);
+/// VTK XML PolyData (.vtp), appended binary (zlib-compressed blocks when `zlib`, else raw),
+/// with a Verts cell per point so ParaView draws the points. Positions and float arrays are
+/// Float32, integer arrays Int64.
+std::string vtp_bytes(const PointSet& points, bool zlib = true);
 
 /// VTK XML PolyData (.vtp) of polygons over the points (each a list of point indices), with
 /// the point arrays.
 std::string vtp_polygons_bytes(const PointSet& points,
-                               const std::vector<std::vector<Index>>& polygons);
+                               const std::vector<std::vector<Index>>& polygons, bool zlib = true);
 
-/// VTK XML UnstructuredGrid (.vtu) of tetrahedra, appended raw binary, with the point arrays.
-std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets);
+/// VTK XML UnstructuredGrid (.vtu) of tetrahedra, appended binary as vtp_bytes, with the point
+/// arrays.
+std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets,
+                      bool zlib = true);
 
 /// One data set of a ParaView collection (.pvd).
 struct PvdEntry {

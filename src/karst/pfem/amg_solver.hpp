@@ -1,8 +1,8 @@
 #pragma once
 // Conjugate gradients preconditioned by hypre's BoomerAMG (algebraic multigrid), for the
-// symmetric positive definite systems of the Biot call (method.md §5.3) when the mesh is too big
-// or changes too often for a direct factorisation (see LinearSolver in biot.hpp). hypre types stay
-// in amg_solver.cpp.
+// symmetric positive definite systems of the Biot call (docs/method.md §5.3) when the mesh is too
+// big or changes too often for a direct factorisation (see LinearSolver in biot.hpp). hypre types
+// stay in amg_solver.cpp.
 #include "karst/core/types.hpp"
 
 #include <Eigen/SparseCore>

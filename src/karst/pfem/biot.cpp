@@ -1,5 +1,5 @@
-// The staggered solve of the Biot problem (method.md §5.3, M22); assembly in biot_assembly.cpp,
-// linear solvers in sparse_linear.hpp.
+// The staggered solve of the Biot problem (docs/method.md §5.3, M22); assembly in
+// biot_assembly.cpp, linear solvers in sparse_linear.hpp.
 //
 // Weak form (P1 on u and p, backward Euler over dt):
 //   K u - Q p = f_ext                                   (equilibrium)

@@ -1,6 +1,6 @@
 #pragma once
 // The Biot poroelastic problem on a fragment's tet mesh and its staggered solution
-// (method.md §5.3, M22): P1 tets, element matrices K, Q, H, lumped storage and volume, and the
+// (docs/method.md §5.3, M22): P1 tets, element matrices K, Q, H, lumped storage and volume, and the
 // fixed-stress split (L = B^2 / K_dr) or, for comparison, the paper's fixed-strain order (L = 0).
 #include "karst/pfem/tet_mesh.hpp"
 
@@ -71,7 +71,7 @@ struct BiotOptions {
     /// Anderson acceleration of the fixed-stress pressure iterates over this many previous ones
     /// (0: the plain M22 iteration).
     int anderson_depth = 3;
-    /// M21: EDT polyhedra with Laplace shape functions instead of P1 tets (method.md §5.2).
+    /// M21: EDT polyhedra with Laplace shape functions instead of P1 tets (docs/method.md §5.2).
     bool polyhedral = false;
     LinearSolver linear_solver = LinearSolver::Auto;
     Real amg_tolerance = 1e-8;  ///< CG residual, relative to that of its warm start
@@ -112,10 +112,10 @@ public:
     void set_mobility(std::vector<Mat3> mobility);
 
     /// Nodal loads (N, per node) added to the body force and the problem's own nodal_force from
-    /// the next call on: the fluid's forces on a coupled fragment (method.md §5.3).
+    /// the next call on: the fluid's forces on a coupled fragment (docs/method.md §5.3).
     void set_extra_loads(const std::vector<Vec3>& loads);
 
-    /// Boundary values from the next call on (time tables, method.md §5.3): nodal loads that
+    /// Boundary values from the next call on (time tables, docs/method.md §5.3): nodal loads that
     /// replace the problem's nodal_force, and the values of the already prescribed displacement
     /// components and drained pressures (an empty array leaves those unchanged).
     void set_boundary_values(const std::vector<Vec3>& nodal_force,

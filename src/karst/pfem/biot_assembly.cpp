@@ -1,4 +1,4 @@
-// Assembly of the Biot problem's matrices (method.md §5.3): P1 tets or M21 polyhedra for the
+// Assembly of the Biot problem's matrices (docs/method.md §5.3): P1 tets or M21 polyhedra for the
 // elasticity K, coupling Q, consistent mass, lumped volume and body force; the Darcy matrix H
 // and gravity flux b; the free and prescribed unknowns. The weak form is in biot.cpp.
 #include "karst/core/parallel.hpp"

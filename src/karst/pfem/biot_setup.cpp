@@ -40,7 +40,7 @@ TetMesh mesh_points(const Model& model, const std::vector<Vec3>& x, PfemTimings&
     options.alpha = pe.alpha, options.join_delta = pe.join_delta,
     options.weighted = pe.weighted_alpha;
     const std::vector<Real> size(x.size(), model.dx);
-    // Weighted variant (method.md §5.1): w = (omega_S S + omega_m m/m_bar) (dx/2)^2 with a
+    // Weighted variant (docs/method.md §5.1): w = (omega_S S + omega_m m/m_bar) (dx/2)^2 with a
     // saturated, uniform-mass solid: S = 1, m = m_bar.
     const std::vector<Real> weights(options.weighted ? x.size() : 0,
                                     (1.0 + 0.2) * 0.25 * model.dx * model.dx);
@@ -53,7 +53,7 @@ BiotMaterial biot_material(const Model& model, const PorousMaterial& m) {
     BiotMaterial b;
     b.youngs_modulus = m.youngs_modulus, b.poisson_ratio = m.poisson_ratio,
     b.biot_coefficient = m.biot_coefficient;
-    // 1/M = phi/K_f + (B - phi)/K_s (method.md §5.3).
+    // 1/M = phi/K_f + (B - phi)/K_s (docs/method.md §5.3).
     b.storage = m.porosity / model.scene.poroelastic.fluid_bulk_modulus +
                 (m.biot_coefficient - m.porosity) / b.grain_bulk_modulus();
     b.fluid_density = model.rho0;
@@ -70,7 +70,7 @@ bool on_region(const Model& model, const Constraint& c, const Vec3& x) {
 }
 
 /// Nodes touching a static wall (within a spacing of its particle skin) are anchored, u = 0
-/// (method.md §5.3): a block resting on the ground is held by it.
+/// (docs/method.md §5.3): a block resting on the ground is held by it.
 bool touches_wall(const Model& model, const Vec3& x) {
     for (const Wall& w : model.scene.walls) {
         const Real d = w.shape.signed_distance(x);

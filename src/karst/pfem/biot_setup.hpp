@@ -1,6 +1,6 @@
 #pragma once
-// From a scene's porous solid to its Biot problem (method.md §5.1-5.5): the mesh of a point set,
-// the Biot material and boundary conditions, the solver options, the porosity and permeability
+// From a scene's porous solid to its Biot problem (docs/method.md §5.1-5.5): the mesh of a point
+// set, the Biot material and boundary conditions, the solver options, the porosity and permeability
 // feedback at the nodes, and the mesh frame arrays.
 #include "karst/io/frame_writer.hpp"
 #include "karst/pfem/biot.hpp"
@@ -16,7 +16,7 @@ namespace karst {
 /// weighted-alpha settings.
 TetMesh mesh_points(const Model& model, const std::vector<Vec3>& x, PfemTimings& timings);
 
-/// The saturated Biot material of a porous material (method.md §5.3).
+/// The saturated Biot material of a porous material (docs/method.md §5.3).
 BiotMaterial biot_material(const Model& model, const PorousMaterial& material);
 
 /// The values of the scene's constraints at `time` (their tables' factors) on `mesh`: nodal

@@ -3,7 +3,7 @@
 // fraction of the spacing. Nodes on a face keep their coordinate normal to it, so the box's
 // faces stay flat for boundary conditions.
 //
-// [D, deviation from method.md §5.1.1] The sheet jitters lattices by 1e-3 dx because they are
+// [D, deviation from docs/method.md §5.1.1] The sheet jitters lattices by 1e-3 dx because they are
 // fully degenerate for Delaunay. CGAL's exact predicates with symbolic perturbation handle the
 // degeneracy (1.4-1.7x slower, perf-facts.md) and give a conforming mesh of 6 tets per cell with
 // no sliver; the jittered lattice gives ~1 flat sliver per cell between cells whose shared

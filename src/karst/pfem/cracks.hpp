@@ -1,5 +1,5 @@
 #pragma once
-// Where a structure cracks (method.md §5.5, M25-M26) and which element links a crack cuts
+// Where a structure cracks (docs/method.md §5.5, M25-M26) and which element links a crack cuts
 // (§5.6): pure functions of the mesh and its nodal stresses, so they can be tested alone.
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/structure_state.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Links between the elements of a mesh (method.md §5.5, M27): two tets are linked when they
+// Links between the elements of a mesh (docs/method.md §5.5, M27): two tets are linked when they
 // share a face. Fracture breaks links; the unbroken ones say which elements hold together.
 #include "karst/pfem/structure_state.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// Algorithm 2 l.8-21 on State (method.md §5.5-5.6): after a Biot call, every structure is
+// Algorithm 2 l.8-21 on State (docs/method.md §5.5-5.6): after a Biot call, every structure is
 // tested for Rankine cracks (M25-M26); the links they cut break, nodes whose elements fall apart
 // split into new porous particles (M27), and the pieces no longer held by an anchor become free
 // rigid fragments. Mass, pore water and the linear and angular momentum are kept exactly.

@@ -1,5 +1,5 @@
 #pragma once
-// Laplace (non-Sibsonian) shape functions on an EDT polyhedron (method.md §5.2, M21):
+// Laplace (non-Sibsonian) shape functions on an EDT polyhedron (docs/method.md §5.2, M21):
 //   N_i(x) = (s_i / h_i) / sum_j (s_j / h_j),
 // s_i the area of the Voronoi facet shared by x and node i in the Voronoi diagram of
 // {x} and the nodes, h_i = |x - n_i|. On a single tet they are the barycentric coordinates.

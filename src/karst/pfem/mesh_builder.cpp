@@ -1,6 +1,7 @@
-// The one translation unit that includes CGAL (method.md §5.1). Everything else sees tet_mesh.hpp.
+// The one translation unit that includes CGAL (docs/method.md §5.1). Everything else sees
+// tet_mesh.hpp.
 //
-// Slivers (method.md §5.1.3) are dropped only where they touch the surface, as Kratos does
+// Slivers (docs/method.md §5.1.3) are dropped only where they touch the surface, as Kratos does
 // [D, deviation]: an interior sliver is typically the flat tet between two lattice cells whose
 // Delaunay split their shared square along different diagonals. Dropping it leaves the two
 // sides non-conforming, and the patch test then fails at the nodes beside it. Kept, the mesh is

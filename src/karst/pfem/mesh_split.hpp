@@ -1,5 +1,5 @@
 #pragma once
-// Node splitting along broken links (method.md §5.6, M27) and the extraction of a mesh's
+// Node splitting along broken links (docs/method.md §5.6, M27) and the extraction of a mesh's
 // components, on the mesh alone: the caller carries the particles (mass, water, momentum) along
 // with the `source` and `share` arrays.
 #include "karst/pfem/structure_state.hpp"

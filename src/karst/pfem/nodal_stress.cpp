@@ -22,7 +22,7 @@ NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
                          const BiotFields& fields) {
     const Index n = mesh.node_count();
     const Real lambda = material.lame_lambda(), mu = material.shear_modulus();
-    // [D, refines method.md §5.5] The nodal strain for the crack test is recovered by a linear
+    // [D, refines docs/method.md §5.5] The nodal strain for the crack test is recovered by a linear
     // least-squares fit of the element strains (at their centroids, weighted by volume) over the
     // tets around the node, evaluated at the node (Zienkiewicz-Zhu patch recovery). The plain
     // volume-weighted average the sheet names is first order: at a surface it reads the stress

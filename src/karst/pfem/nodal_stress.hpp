@@ -1,5 +1,5 @@
 #pragma once
-// Stresses at the nodes (method.md §5.5): the element strains recovered at the nodes by a
+// Stresses at the nodes (docs/method.md §5.5): the element strains recovered at the nodes by a
 // linear patch fit (nodal_stress.cpp says why), eps_v as the volume-weighted average.
 #include "karst/pfem/biot.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// Linear (P1) shape functions on one tetrahedron (method.md §5.2): N_a are the barycentric
+// Linear (P1) shape functions on one tetrahedron (docs/method.md §5.2): N_a are the barycentric
 // coordinates, so their gradients are constant over the tet.
 #include "karst/pfem/tet_mesh.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// EDT polyhedra as finite elements with Laplace shape functions (method.md §5.2, M21, the
+// EDT polyhedra as finite elements with Laplace shape functions (docs/method.md §5.2, M21, the
 // "faithful option"): each polyhedron's nodes and its quadrature points, the centroids of its
 // sub-tets weighted by their volumes, with N and grad N there.
 #include "karst/pfem/tet_mesh.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Dynamic porosity and permeability from the Biot solution (method.md §5.4).
+// Dynamic porosity and permeability from the Biot solution (docs/method.md §5.4).
 #include "karst/core/types.hpp"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 #pragma once
-// Whether a body's displacement constraints hold all six rigid-body modes (method.md §5.3): a
+// Whether a body's displacement constraints hold all six rigid-body modes (docs/method.md §5.3): a
 // piece held at one node, or along one line, can still turn, and its elasticity matrix is then
 // singular. Fracture uses it to tell which pieces stay anchored; the Biot setup to know when the
 // rigid-mode spring is needed.

@@ -1,5 +1,5 @@
 #pragma once
-// The stages of Algorithm 2 (method.md §5) on State::structures, in the order sim/step.cpp
+// The stages of Algorithm 2 (docs/method.md §5) on State::structures, in the order sim/step.cpp
 // calls them: loads -> the particles follow u -> remesh triggers (§4.10) -> Biot (M22) ->
 // feedback (§5.4). Every anchored fragment of a permeable solid has a structure: in a coupled
 // run its loads are the fluid's reactions and the contact forces on its particles; a

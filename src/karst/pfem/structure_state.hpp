@@ -1,5 +1,5 @@
 #pragma once
-// The structure side's physical state (method.md §5), as plain data inside State: per anchored
+// The structure side's physical state (docs/method.md §5), as plain data inside State: per anchored
 // fragment of a permeable solid its PFEM mesh on the rest positions, the links between its
 // elements, the Biot fields, and per porous particle id the rest position, displacement and the
 // loads summed since the last Biot call. The solvers (factorisations, AMG hierarchies) are not
@@ -13,7 +13,7 @@
 
 namespace karst {
 
-/// Two elements sharing a face (method.md §5.5, M27): fracture breaks links, and the unbroken
+/// Two elements sharing a face (docs/method.md §5.5, M27): fracture breaks links, and the unbroken
 /// ones say which elements still hold together.
 struct ElementLink {
     Index a = 0, b = 0;  ///< tets of the mesh, a < b
@@ -44,7 +44,7 @@ struct PfemTimings {
     Index unconverged_calls = 0;  ///< calls that ended at max_iterations above the tolerance
 };
 
-/// A crack disk made by fracture (method.md §5.5), in world coordinates.
+/// A crack disk made by fracture (docs/method.md §5.5), in world coordinates.
 struct CrackRecord {
     Vec3 centre = Vec3::Zero(), normal = Vec3::UnitZ();  ///< m, unit
     Real radius = 0, area = 0;                           ///< m, m^2 (M26, before the clamp)

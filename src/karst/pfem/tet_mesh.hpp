@@ -1,5 +1,5 @@
 #pragma once
-// The PFEM mesh of one fragment as plain arrays (method.md §5.1): no CGAL type leaves
+// The PFEM mesh of one fragment as plain arrays (docs/method.md §5.1): no CGAL type leaves
 // mesh_builder.cpp, so only that translation unit pays for CGAL's headers.
 #include "karst/core/types.hpp"
 

@@ -1,4 +1,4 @@
-// Shape measures of single tets (method.md §5.1 quality figures, §4.10 distortion trigger).
+// Shape measures of single tets (docs/method.md §5.1 quality figures, §4.10 distortion trigger).
 #include "karst/pfem/tet_mesh.hpp"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 #pragma once
-// The anisotropic spiky kernel of the pore flow (method.md §6, M16): W(x, G) = det(G) w(|G x|)
+// The anisotropic spiky kernel of the pore flow (docs/method.md §6, M16): W(x, G) = det(G) w(|G x|)
 // with w(q) = (15/pi)(1 - q)^3 on the unit ball, and the pair weight of the conservative flux.
 #include "karst/core/types.hpp"
 
@@ -15,7 +15,7 @@ inline Real pair_weight(const Vec3& x, const Mat3& G, Real det_g) {
     return (90 / std::numbers::pi) * det_g * (1 - q) * (1 - q) * q / (q * q + 0.01);
 }
 
-/// c_eps of method.md §4.7.2: d / int |y| (-w'(|y|)) |y|^2 / (|y|^2 + 0.01) dy over the unit
+/// c_eps of docs/method.md §4.7.2: d / int |y| (-w'(|y|)) |y|^2 / (|y|^2 + 0.01) dy over the unit
 /// ball, which removes the regulariser's bias (about 1.046 in 3D); composite Simpson, 4096 panels.
 inline Real pair_weight_calibration() {
     // int_0^1 4 pi y^2 * y * (45/pi)(1-y)^2 * y^2/(y^2+0.01) dy.

@@ -1,5 +1,5 @@
 #pragma once
-// Dissolution into muddy fluid (method.md §4.8): saturated, high-porosity porous particles
+// Dissolution into muddy fluid (docs/method.md §4.8): saturated, high-porosity porous particles
 // become fluid particles carrying their grains as solute, conserving mass and momentum.
 #include "karst/porous/pore_water.hpp"
 #include "karst/sim/state.hpp"
@@ -43,7 +43,8 @@ struct DissolutionReport {
 /// own volume and the slurry is denser than water [D: the sheet's V = m / rho0 put 1.5 lattice
 /// volumes into one site, 16 % over-dense, and blew it out at 250 m/s]. It is split into
 /// ceil(m / m_f0) pieces when m > 2 m_f0; the porous particle is removed (its fragment must then
-/// update its mass properties and remesh, method.md §4.8). New fluid ids continue from `next_id`.
+/// update its mass properties and remesh, docs/method.md §4.8). New fluid ids continue from
+/// `next_id`.
 DissolutionReport dissolve(PorousParticles& porous, FluidParticles& fluid,
                            std::span<const PoreWaterLaw> laws, const DissolutionSettings& settings,
                            std::int64_t& next_id, const std::vector<char>& exposed = {});

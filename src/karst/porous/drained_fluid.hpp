@@ -1,5 +1,5 @@
 #pragma once
-// Deletion of drained fluid particles (method.md §4.7.3): a fluid particle whose water has
+// Deletion of drained fluid particles (docs/method.md §4.7.3): a fluid particle whose water has
 // almost all soaked into the porous solid gives the rest to the porous particle that took most
 // of it, and its solute to its nearest fluid neighbour.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Weighted PCA of a particle's neighbourhood (method.md §6.2, Yu & Turk 2013, M28): the local
+// Weighted PCA of a particle's neighbourhood (docs/method.md §6.2, Yu & Turk 2013, M28): the local
 // frame of complex geometry. karst uses it only for the layering frame ("axes from geometry");
 // the permeability ratios come from the scene through K0 (M12), never from sampling noise.
 #include "karst/core/types.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Permeability tensors and the anisotropic kernel tensor G (method.md §4.6, M12, M13).
+// Permeability tensors and the anisotropic kernel tensor G (docs/method.md §4.6, M12, M13).
 #include "karst/core/types.hpp"
 
 #include <Eigen/Eigenvalues>

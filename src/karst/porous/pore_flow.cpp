@@ -188,8 +188,8 @@ Real PoreFlow::paper_pair_flux(const PorousParticles& p, const PorePairs& pairs,
     const Index lo = std::min(i, j), hi = std::max(i, j);
     const Vec3 x = p.x[lo] - p.x[hi];
     const Vec3 r = x / x.norm();
-    // d_ij = (|v_pi.r| S_i^beta + |v_pj.r| S_j^beta) / 2 >= 0 (method.md §9 item 7), in (lo, hi)
-    // order so both sides agree bitwise.
+    // d_ij = (|v_pi.r| S_i^beta + |v_pj.r| S_j^beta) / 2 >= 0 (docs/method.md §9 item 7), in (lo,
+    // hi) order so both sides agree bitwise.
     const Real d = 0.5 * (std::abs(m_pore_velocity[lo].dot(r)) * m_relative_permeability[lo] +
                           std::abs(m_pore_velocity[hi].dot(r)) * m_relative_permeability[hi]);
     const Real into_lo = d / m_h * p.volume[lo] * p.volume[hi] *

@@ -1,8 +1,8 @@
 #pragma once
-// Conservative pore-water transport (method.md §4.7, M14-M16): one antisymmetric Darcy flux per
-// pair in the metric of the anisotropic kernel, between porous particles and between porous
-// and fluid particles (absorption and back-flow, §4.7.3), with the donor limiter and sub-steps
-// of §4.7.5. Total water is conserved to round-off.
+// Conservative pore-water transport (docs/method.md §4.7, M14-M16): one antisymmetric Darcy flux
+// per pair in the metric of the anisotropic kernel, between porous particles and between porous and
+// fluid particles (absorption and back-flow, §4.7.3), with the donor limiter and sub-steps of
+// §4.7.5. Total water is conserved to round-off.
 #include "karst/porous/pore_water.hpp"
 #include "karst/sph/fluid_particles.hpp"
 #include "karst/sph/neighbour_grid.hpp"
@@ -50,7 +50,7 @@ struct PorePairs {
 };
 
 /// The pair flux between porous particles: the Darcy flux M15 (default), or the paper's Eq. 20 in
-/// the conservative form of method.md §9 item 7, q_{j->i} = (d_ij / h) V_i V_j (m_pj / V_j -
+/// the conservative form of docs/method.md §9 item 7, q_{j->i} = (d_ij / h) V_i V_j (m_pj / V_j -
 /// m_pi / V_i) F_ij with d_ij = (|v_pi.r| S_i^beta + |v_pj.r| S_j^beta) / 2 and v_p from M17. The
 /// latter diffuses m_p / V along the pore velocity: conservative and stable, but blind to
 /// gravity and capillarity as drivers. Fluid-porous pairs use M15 in both.

@@ -1,5 +1,5 @@
 #pragma once
-// The pore-water state of porous particles and its constitutive laws (method.md §2, M3-M6).
+// The pore-water state of porous particles and its constitutive laws (docs/method.md §2, M3-M6).
 #include "karst/core/soa.hpp"
 #include "karst/core/types.hpp"
 
@@ -9,7 +9,7 @@
 
 namespace karst {
 
-/// Porous particles as structure-of-arrays (method.md §2). Mass of pore water m_p is the
+/// Porous particles as structure-of-arrays (docs/method.md §2). Mass of pore water m_p is the
 /// conserved quantity. `rest` and `material` may stay empty for a set of one material that
 /// belongs to no rigid fragment (the poroelastic-only solver, unit tests).
 struct PorousParticles {
@@ -43,7 +43,7 @@ struct PorousParticles {
 /// Below this porosity a particle is impermeable (M3) and takes part in no transfer.
 inline constexpr Real k_min_porosity = 1e-4;
 
-/// Material constants of the pore water (method.md §8.2 defaults).
+/// Material constants of the pore water (docs/method.md §8.2 defaults).
 struct PoreWaterLaw {
     Real rest_density = 1000;       ///< rho0, kg/m^3
     Real capillary_scale = 2000;    ///< k^c, Pa

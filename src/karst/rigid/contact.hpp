@@ -1,5 +1,5 @@
 #pragma once
-// Contact springs between porous particles of different fragments (method.md §4.2):
+// Contact springs between porous particles of different fragments (docs/method.md §4.2):
 //   F_{i<-j} = [k_c (d0 - r) - c_c (v_ij . r_hat)] r_hat   for r < d0 = dx,
 // applied in equal and opposite pairs. Springs inside one fragment would cancel in its rigid sum,
 // so only pairs across fragments count; and none between the halves of one split particle (M27),
@@ -13,7 +13,7 @@ struct ContactLaw {
     Real rest_distance = 0.02;  ///< d0 = dx, m
     Real stiffness = 0;         ///< k_c, N/m
     Real damping = 0;           ///< c_c, N s/m
-    /// k_c = M g / (0.01 dx) for the lightest fragment M in contact (method.md §4.2), and the
+    /// k_c = M g / (0.01 dx) for the lightest fragment M in contact (docs/method.md §4.2), and the
     /// damping that gives a normal restitution e for two particles of mass m_pair each.
     static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity,
                                     Real particle_mass, Real restitution = 0.2);

@@ -1,5 +1,5 @@
 #pragma once
-// Fragments as rigid bodies (method.md §4.5): mass properties from the members (wet mass
+// Fragments as rigid bodies (docs/method.md §4.5): mass properties from the members (wet mass
 // included), and the integration of one step. The state carries the angular momentum L rather
 // than omega, so a torque-free fragment keeps L exactly (an explicit update of omega with the
 // gyroscopic term does not).

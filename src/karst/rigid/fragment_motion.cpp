@@ -10,7 +10,7 @@ namespace karst {
 
 namespace {
 
-/// The contact law of method.md §4.2 for the lightest free fragment (mass M, N members).
+/// The contact law of docs/method.md §4.2 for the lightest free fragment (mass M, N members).
 /// [D] The sheet's k_c = M g / (0.01 dx) holds a fragment on one particle. A fragment resting on
 /// a face touches about N^(2/3) particles, which is N^(2/3) times stiffer: omega^2 = N^(2/3) g /
 /// (0.01 dx), so omega dt = 9 for a 1000-particle cube at a 5 ms step, and explicit steps blow

@@ -1,6 +1,6 @@
 #pragma once
-// The fragments' step (method.md §4.5, §3 steps 6-7): contact springs, the sum of the forces on
-// their members, rigid integration and the members' new positions, velocities and world
+// The fragments' step (docs/method.md §4.5, §3 steps 6-7): contact springs, the sum of the forces
+// on their members, rigid integration and the members' new positions, velocities and world
 // permeability tensors; and the mass properties after pore water or members change.
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"

@@ -221,7 +221,7 @@ Scene parse_scene(const std::string& text) {
     s.fracture.enabled = doc["fracture"]["enabled"],
     s.fracture.max_cracks_per_call = doc["fracture"]["max_cracks_per_call"];
     s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"],
-    s.output.ply = doc["output"]["ply"];
+    s.output.ply = doc["output"]["ply"], s.output.compress = doc["output"]["compress"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];
     return s;

@@ -74,7 +74,7 @@ struct PorousMaterial {
     Vec3 layering_normal = Vec3::Zero();  ///< bedding normal, or fibre tangent
     Real layering_ratio{};                ///< k along / k across the layers (fibres)
     std::optional<Real> strength_across;  ///< sigma_t across bedding planes, Pa; absent: sigma_t
-    Real dissolution_porosity{};          ///< phi_diss (method.md §4.8)
+    Real dissolution_porosity{};          ///< phi_diss (docs/method.md §4.8)
     Real dissolution_saturation{};        ///< S_diss
     Real absorption_factor{};             ///< chi_abs of M15
 };
@@ -117,7 +117,7 @@ struct Constraint {
 
 struct PorousSolid {
     Shape shape;
-    bool anchored{};                       ///< else a free rigid fragment (method.md §4.5)
+    bool anchored{};                       ///< else a free rigid fragment (docs/method.md §4.5)
     Vec3 velocity = Vec3::Zero();          ///< initial, m/s
     Vec3 angular_velocity = Vec3::Zero();  ///< initial, rad/s
     PorousMaterial material;
@@ -153,6 +153,7 @@ struct OutputSettings {
     Real fps{};
     bool vtp{};
     bool ply{};
+    bool compress{};  ///< zlib blocks in the VTK frames
 };
 
 struct Scene {

@@ -44,7 +44,7 @@ std::vector<KeySpec> make_schema() {
         required("/name", T::String, "", any(),
                  "Scene name; output goes to out/<name>/ by default."),
         required("/particle_spacing", T::Number, "m", positive(10.0),
-                 "Particle spacing dx. The SPH support radius is h = 2 dx (method.md §1)."),
+                 "Particle spacing dx. The SPH support radius is h = 2 dx (docs/method.md §1)."),
         key("/gravity", T::Vec3, "m/s^2", closed(-1000, 1000), json::array({0.0, 0.0, -9.81}),
             "Gravitational acceleration; z is up."),
         optional("/domain", T::Object, "", any(),
@@ -59,7 +59,8 @@ std::vector<KeySpec> make_schema() {
             "CFL number lambda_v: dt <= lambda_v dx / v_max (M11)."),
         key("/time/dt_max", T::Number, "s", positive(1.0), 5e-3, "Upper clamp of the time step."),
         key("/time/dt_min", T::Number, "s", positive(1.0), 1e-7,
-            "Smallest adaptive step: a run whose step falls below it stops with exit 1 (it is unstable or far too fast for the spacing)."),
+            "Smallest adaptive step: a run whose step falls below it stops with exit 1 (it is "
+            "unstable or far too fast for the spacing)."),
         optional("/time/fixed_dt", T::Number, "s", positive(1.0),
                  "Fixed time step; absent: adaptive CFL step (M11)."),
 
@@ -67,9 +68,10 @@ std::vector<KeySpec> make_schema() {
         key("/fluid/rest_density", T::Number, "kg/m^3", closed(100, 20000), 1000.0,
             "Rest density rho0."),
         key("/fluid/viscosity", T::Number, "m^2/s", closed(0, 1.0), 1e-6,
-            "Kinematic viscosity nu (method.md §4.2)."),
+            "Kinematic viscosity nu (docs/method.md §4.2)."),
         key("/fluid/artificial_viscosity", T::Number, "", closed(0, 1), 0.01,
-            "alpha_v of the Becker-Teschner artificial viscosity (method.md §4.2), acting only "
+            "alpha_v of the Becker-Teschner artificial viscosity (docs/method.md §4.2), acting "
+            "only "
             "between "
             "approaching particles; 0 disables it. Water at scene resolution has almost no "
             "physical damping, and "
@@ -88,7 +90,7 @@ std::vector<KeySpec> make_schema() {
             "Numerical sound speed c_s used by wall friction and artificial viscosity (about 10x "
             "the expected speed)."),
         key("/fluid/solute_diffusivity", T::Number, "m^2/s", closed(0, 1), 1e-4,
-            "Diffusivity D of the solute among fluid particles (M18; scene-scaled, method.md "
+            "Diffusivity D of the solute among fluid particles (M18; scene-scaled, docs/method.md "
             "§8.2)."),
         key("/fluid/solver", T::Enum, "", any(), "dfsph",
             "Pressure solver. dfsph: divergence-free SPH (Bender & Koschier 2017), a "
@@ -96,7 +98,7 @@ std::vector<KeySpec> make_schema() {
             "that keeps dense fluid from compressing further, then the constant-density solve, "
             "both "
             "with the Akinci boundary of walls and porous particles; pcisph: the paper's "
-            "predictive-corrective solver (method.md §4.3), kept for comparison: it can gain "
+            "predictive-corrective solver (docs/method.md §4.3), kept for comparison: it can gain "
             "energy in "
             "impacts.",
             {"dfsph", "pcisph"}),
@@ -121,7 +123,7 @@ std::vector<KeySpec> make_schema() {
         key("/fluid_blocks/[]/velocity", T::Vec3, "m/s", closed(-1000, 1000), zero3,
             "Initial velocity."),
         key("/fluid_blocks/[]/concentration", T::Number, "", closed(0, 1), 0.0,
-            "Initial solute concentration C = m_sol / m (muddy water), method.md §4.9."),
+            "Initial solute concentration C = m_sol / m (muddy water), docs/method.md §4.9."),
 
         key("/walls", T::ObjectArray, "", any(), json::array(),
             "Static walls sampled as Akinci 2012 boundary particles."),
@@ -135,7 +137,8 @@ std::vector<KeySpec> make_schema() {
             "slip through between steps; two is the safe default."),
 
         key("/porous_solids", T::ObjectArray, "", any(), json::array(),
-            "Porous solids (method.md §2, §4.5-4.8): particles on the scene lattice. With fluid "
+            "Porous solids (docs/method.md §2, §4.5-4.8): particles on the scene lattice. With "
+            "fluid "
             "blocks, or when a "
             "solid is free, each solid is a rigid fragment coupled two-way with the fluid (Akinci "
             "boundary), "
@@ -146,7 +149,8 @@ std::vector<KeySpec> make_schema() {
             "(PFEM) and the Biot solver runs by itself with /poroelastic/time_step."),
         required("/porous_solids/[]/shape", T::Shape, "", any(), "Geometry of the solid."),
         key("/porous_solids/[]/anchored", T::Bool, "", any(), true,
-            "true: the solid stays put (a rock on the ground); false: a free rigid body (method.md "
+            "true: the solid stays put (a rock on the ground); false: a free rigid body "
+            "(docs/method.md "
             "§4.5) "
             "moved by gravity, the fluid and contact with walls and other solids."),
         key("/porous_solids/[]/velocity", T::Vec3, "m/s", closed(-1e3, 1e3), zero3,
@@ -159,7 +163,7 @@ std::vector<KeySpec> make_schema() {
             "Porosity phi0. Below 1e-4 the solid is impermeable (M3): it takes no water, e.g. a "
             "floating box."),
         key("/porous_solids/[]/material/permeability", T::Number, "m^2", closed(1e-25, 1e-3), 2e-8,
-            "Intrinsic permeability k0 (scene-scaled default, method.md §8.2)."),
+            "Intrinsic permeability k0 (scene-scaled default, docs/method.md §8.2)."),
         key("/porous_solids/[]/material/darcy_viscosity", T::Number, "Pa s", closed(1e-6, 1e6), 0.1,
             "Dynamic viscosity eta of the pore water in Darcy's law."),
         key("/porous_solids/[]/material/solid_density", T::Number, "kg/m^3", closed(10, 30000),
@@ -189,9 +193,10 @@ std::vector<KeySpec> make_schema() {
         key("/porous_solids/[]/material/initial_saturation", T::Number, "", closed(0, 1.2), 0.0,
             "Saturation S at t = 0 outside the wet regions."),
         key("/porous_solids/[]/material/dissolution_porosity", T::Number, "", closed(0, 1), 0.6,
-            "phi_diss of method.md §4.8: particles at least this porous dissolve once saturated."),
+            "phi_diss of docs/method.md §4.8: particles at least this porous dissolve once "
+            "saturated."),
         key("/porous_solids/[]/material/dissolution_saturation", T::Number, "", closed(0.5, 2),
-            0.98, "S_diss of method.md §4.8."),
+            0.98, "S_diss of docs/method.md §4.8."),
         key("/porous_solids/[]/material/absorption_factor", T::Number, "", closed(0, 1e3), 1.0,
             "chi_abs of M15: scales the permeability of fluid-porous pairs (how fast the surface "
             "absorbs)."),
@@ -214,7 +219,7 @@ std::vector<KeySpec> make_schema() {
                  positive(1e12),
                  "bedding and from_geometry only: the tensile strength across the bedding planes. "
                  "Layered rock splits along its layers: a crack along the layer opens where the "
-                 "effective normal stress across it exceeds this (method.md M25). Absent: the "
+                 "effective normal stress across it exceeds this (docs/method.md M25). Absent: the "
                  "material's tensile_strength."),
         key("/porous_solids/[]/wet_regions", T::ObjectArray, "", any(), json::array(),
             "Regions of the solid that start wet."),
@@ -251,36 +256,38 @@ std::vector<KeySpec> make_schema() {
                  "that ramps to failure, a pressure raised in steps, a platen moved at a rate."),
 
         key("/pore_flow", T::Object, "", any(), json::object(),
-            "Transport of pore water between porous particles (method.md §4.7)."),
+            "Transport of pore water between porous particles (docs/method.md §4.7)."),
         key("/pore_flow/pair_flux", T::Enum, "", any(), "darcy",
             "darcy: the conservative Darcy pair flux M15, driven by pore pressure, capillarity and "
             "gravity; "
-            "paper_eq20: the paper's Eq. 20 in its conservative form (method.md §9 item 7), which "
+            "paper_eq20: the paper's Eq. 20 in its conservative form (docs/method.md §9 item 7), "
+            "which "
             "diffuses the "
             "absorbed mass along the pore velocity and ignores gravity and capillarity as drivers, "
             "for comparison.",
             {"darcy", "paper_eq20"}),
         key("/poroelastic", T::Object, "", any(), json::object(),
-            "PFEM mesh and Biot solver (method.md §5)."),
+            "PFEM mesh and Biot solver (docs/method.md §5)."),
         key("/poroelastic/time_step", T::Number, "s", positive(1e6), 1.0 / 30,
-            "Biot step dt_B (one call per step; method.md §8.2: one per frame)."),
+            "Biot step dt_B (one call per step; docs/method.md §8.2: one per frame)."),
         key("/poroelastic/coupled_fragments", T::Enum, "", any(), "anchored",
             "In a scene with fluid or free solids: anchored: every anchored fragment of a "
             "permeable solid is "
             "meshed and gets a Biot call every time_step, loaded by the fluid's forces, with its "
             "pore pressure "
-            "from the pore water, feeding porosity, bulk volume and permeability back (method.md "
+            "from the pore water, feeding porosity, bulk volume and permeability back "
+            "(docs/method.md "
             "§5); none: "
             "fragments stay rigid (faster; no stress, no mesh frames). Free fragments are not "
             "solved.",
             {"anchored", "none"}),
         key("/poroelastic/fluid_bulk_modulus", T::Number, "Pa", closed(1, 1e12), 1e5,
             "Pore-water bulk modulus K_f in the Biot storage 1/M = phi/K_f + (B - phi)/K_s. The "
-            "default is the SPH pore stiffness gamma k^p (method.md §8.2); water is 2.2e9."),
+            "default is the SPH pore stiffness gamma k^p (docs/method.md §8.2); water is 2.2e9."),
         key("/poroelastic/pressure_source", T::Enum, "", any(), "pore_water",
             "pore_water: the pore water moves by Darcy flow among the particles (M15) and seeds "
             "the "
-            "Biot pressure at every call from M5 (method.md §5.3); biot: the Biot pressure is "
+            "Biot pressure at every call from M5 (docs/method.md §5.3); biot: the Biot pressure is "
             "carried from call to call (linear poroelasticity, e.g. Terzaghi's test).",
             {"pore_water", "biot"}),
         key("/poroelastic/splitting", T::Enum, "", any(), "fixed_stress",
@@ -288,7 +295,8 @@ std::vector<KeySpec> make_schema() {
             "when tau = B^2 M/K_dr > 1).",
             {"fixed_stress", "fixed_strain"}),
         key("/poroelastic/shape_functions", T::Enum, "", any(), "p1",
-            "p1: linear tets (method.md §5.2 default); mfem_polyhedra: EDT polyhedra with Laplace "
+            "p1: linear tets (docs/method.md §5.2 default); mfem_polyhedra: EDT polyhedra with "
+            "Laplace "
             "shape functions (M21), slower to assemble but free of the tets' shear locking (a "
             "cantilever: 0.4 % off Timoshenko against 5 % with p1 at the same nodes).",
             {"p1", "mfem_polyhedra"}),
@@ -322,7 +330,8 @@ std::vector<KeySpec> make_schema() {
             "Use the weighted alpha shape (regular triangulation) instead of the plain one."),
 
         key("/fracture", T::Object, "", any(), json::object(),
-            "Fracture of the meshed solids (method.md §5.5-5.6): after every Biot call, Rankine "
+            "Fracture of the meshed solids (docs/method.md §5.5-5.6): after every Biot call, "
+            "Rankine "
             "cracks on the effective stress break element links, split nodes, and pieces no longer "
             "held by an anchor become free rigid fragments."),
         key("/fracture/enabled", T::Bool, "", any(), true,
@@ -334,8 +343,11 @@ std::vector<KeySpec> make_schema() {
         key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0,
             "Frames per simulated second."),
         key("/output/vtp", T::Bool, "", any(), true, "Write fluid_NNNN.vtp frames and run.pvd."),
-        key("/output/ply", T::Bool, "", any(), true,
-            "Write binary PLY point frames fluid_NNNN.ply."),
+        key("/output/ply", T::Bool, "", any(), false,
+            "Also write binary PLY point frames fluid_NNNN.ply (for Houdini and Blender; they "
+            "cannot be compressed and would more than double the output)."),
+        key("/output/compress", T::Bool, "", any(), true,
+            "zlib-compress the VTK frames (ParaView and every VTK reader read both kinds)."),
 
         key("/watchdog", T::Object, "", any(), json::object(), "Run-time sanity limits."),
         key("/watchdog/max_speed", T::Number, "m/s", positive(1e6), 100.0,

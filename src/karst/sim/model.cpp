@@ -256,7 +256,7 @@ Real lattice_volume(const CubicKernel& W, Real dx) {
     return 1 / sum;
 }
 
-/// Boundary weights Psi_k = rho0 V_k (method.md §4.1) of static walls.
+/// Boundary weights Psi_k = rho0 V_k (docs/method.md §4.1) of static walls.
 /// [D] Walls of two or more layers are lattice sites, like the fluid, and fill the kernel's
 /// support beyond the surface, so V_k = the lattice volume makes a resting fluid lattice exactly
 /// rho0 beside flat walls, edges and corners alike; it is capped by the Akinci volume
@@ -302,8 +302,8 @@ void set_up_porous_materials(Model& m) {
     m.porous_grid = UniformGrid(m.domain, reach);
 }
 
-/// The Biot problems a scene can pose (method.md §5): a poroelastic-only solid needs pores, and
-/// in a coupled scene only anchored fragments of permeable solids get one, so constraints on
+/// The Biot problems a scene can pose (docs/method.md §5): a poroelastic-only solid needs pores,
+/// and in a coupled scene only anchored fragments of permeable solids get one, so constraints on
 /// any other solid would be silently ignored.
 void check_biot_setup(const Model& m) {
     const Scene& scene = m.scene;

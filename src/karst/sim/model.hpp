@@ -21,7 +21,7 @@ struct WallParticles {
     Index size() const { return Index(x.size()); }
 };
 
-/// The particles of one porous solid at rest (method.md §2). The PFEM mesh is built on rest_x.
+/// The particles of one porous solid at rest (docs/method.md §2). The PFEM mesh is built on rest_x.
 struct PorousBody {
     Index solid = 0;                      ///< index into scene.porous_solids
     std::vector<Vec3> rest_x;             ///< (n), m

@@ -13,6 +13,7 @@
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
 #include "karst/sim/step.hpp"
+#include "karst/sim/stop_signal.hpp"
 #include "karst/sim/watchdog.hpp"
 #include "karst/sph/density.hpp"
 #include "karst/sph/fluid_neighbours.hpp"
@@ -26,7 +27,7 @@ namespace karst {
 
 namespace {
 
-/// The conserved totals (method.md §4.7-4.8): water is the fluid's mass less its solute and
+/// The conserved totals (docs/method.md §4.7-4.8): water is the fluid's mass less its solute and
 /// the water it already gave (drained), plus the pore water; grains are the solute plus the porous
 /// particles' solid mass.
 struct MassTotals {
@@ -120,7 +121,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
 
     RunResult result;
     result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
-    FrameWriter out(result.out_dir, scene.output);
+    FrameWriter out(result.out_dir, scene.output, opt.overwrite);
     out.write_boundary(model.walls);
     // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the energy
     // released so far is energy the numerics made; the run says so once.
@@ -291,6 +292,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                              fluid_frames ? state.fluid.size() : state.porous.size(),
                              porous ? state.porous.absorbed : -1.0, state.removed,
                              porous ? live_fragments(state) : 0});
+            if (stop_signal()) break;  // after a whole step: the folder stays consistent
         }
     } catch (const WatchdogError& e) {
         progress.finish();
@@ -309,6 +311,10 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             density_tolerance, frames_over_tolerance, out.frames() - 1, max_density_error));
     progress.finish();
     result.stats = stats();
+    if (stop_signal()) {
+        result.stop_signal = stop_signal();
+        result.stats["interrupted"] = {{"signal", result.stop_signal}, {"time", state.time}};
+    }
     out.write_stats(result.stats);
     return result;
 }

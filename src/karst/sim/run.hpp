@@ -19,11 +19,13 @@ struct RunOptions {
     std::optional<double> fps;                     ///< overrides /output/fps
     int threads = 0;                               ///< 0: all cores
     bool quiet = false;
+    bool overwrite = false;  ///< write into a non-empty folder no karst run wrote
 };
 
 struct RunResult {
     bool ok = true;
     std::string failure;  ///< watchdog message when !ok
+    int stop_signal = 0;  ///< SIGINT or SIGTERM that stopped the run early (sim/stop_signal.hpp)
     std::filesystem::path out_dir;
     nlohmann::json stats;  ///< what stats.json holds
 };

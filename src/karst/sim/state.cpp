@@ -9,8 +9,8 @@ namespace karst {
 
 namespace {
 
-/// Porous particles of every solid (method.md §2) and one fragment per solid (§4.5), at rest or
-/// with a free solid's initial velocity and spin.
+/// Porous particles of every solid (docs/method.md §2) and one fragment per solid (§4.5), at rest
+/// or with a free solid's initial velocity and spin.
 void make_porous(const Model& model, PorousState& porous, std::int64_t& next_id) {
     PorousParticles& p = porous.particles;
     for (const PorousBody& body : model.porous) {

@@ -39,7 +39,7 @@ struct FluidScratch {
     std::vector<Real> porous_hydrostatic;  ///< per porous pair: -rho0 g.x_ik, Pa
 };
 
-/// Porous particles and their fragments (method.md §2, §4.5): the physical state.
+/// Porous particles and their fragments (docs/method.md §2, §4.5): the physical state.
 struct PorousState {
     PorousParticles particles;
     std::vector<Fragment>
@@ -76,7 +76,7 @@ struct State {
     FluidScratch scratch;
     PorousState porous;
     PorousScratch porous_scratch;
-    StructureState structures;  ///< Algorithm 2's meshes and fields (method.md §5)
+    StructureState structures;  ///< Algorithm 2's meshes and fields (docs/method.md §5)
     BiotCache biot_cache;       ///< their solvers, rebuilt on demand
     Real time = 0;              ///< s
     Index steps = 0;

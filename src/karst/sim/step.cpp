@@ -1,4 +1,4 @@
-// THE order of the stages of one time step: Algorithm 1 (method.md §3) and, after the rigid
+// THE order of the stages of one time step: Algorithm 1 (docs/method.md §3) and, after the rigid
 // update, Algorithm 2 (§5). Every stage is timed into the profile and followed by the watchdog's
 // check of what it wrote. Numbers are the sheet's §3 steps; two run earlier than the sheet
 // lists them: solute diffusion (10) and the pore flow (8) use the neighbour lists of the step's

@@ -12,7 +12,7 @@ struct StepReport {
     Real max_density_error = 0;     ///< fraction of rho0
 };
 
-/// Advances the state by one step of length dt (method.md §3, and §5 for the anchored
+/// Advances the state by one step of length dt (docs/method.md §3, and §5 for the anchored
 /// fragments' Biot problems), or a half, quarter ... of it when the pressure solve does not
 /// converge (StepReport::dt says which). Throws WatchdogError if a stage produces a NaN or a
 /// runaway speed.

@@ -11,8 +11,8 @@ struct PressureSolveReport {
         0;  ///< largest predicted compression max_i (rho*_i - rho0) / rho0 at the end
 };
 
-/// Stage (method.md §4.3, replaced): divergence-free SPH after Bender & Koschier 2017, with the
-/// Akinci boundary of walls and porous particles. Two solves on the velocities, each a relaxed
+/// Stage (docs/method.md §4.3, replaced): divergence-free SPH after Bender & Koschier 2017, with
+/// the Akinci boundary of walls and porous particles. Two solves on the velocities, each a relaxed
 /// Jacobi iteration on the pressures p_i >= 0 of the linearised density
 ///   rho*_i = rho_i + dt sum_j m_j (v*_i - v*_j).grad W_ij + dt sum_k Psi_k (v*_i - v_k).grad W_ik:
 /// 1. divergence: v* = v + dt a^p(p_div), until no particle at or above rho0 is compressed

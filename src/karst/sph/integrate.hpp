@@ -4,9 +4,9 @@
 
 namespace karst {
 
-/// Stage (method.md §4.4): symplectic Euler v += dt (a_other + a_p), x += dt v; a particle that
-/// crossed a wall's surface is put back inside it (counted in state.pushed_back); then removes the
-/// particles that left the domain (counted in state.removed) and those drained into porous
+/// Stage (docs/method.md §4.4): symplectic Euler v += dt (a_other + a_p), x += dt v; a particle
+/// that crossed a wall's surface is put back inside it (counted in state.pushed_back); then removes
+/// the particles that left the domain (counted in state.removed) and those drained into porous
 /// solids (mass 0). Returns the largest non-pressure acceleration (m/s^2), for the next step's
 /// M11 bound.
 ///
@@ -31,8 +31,9 @@ void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool c
                                    Real dt_max);
 
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max), dt_max), or the scene's fixed step
-/// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now; a_max that of the last step;
-/// also at most the pressure solve's bound (update_solver_time_step_limit).
+/// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now;
+/// a_max that of the last step; also at most the pressure solve's bound
+/// (update_solver_time_step_limit).
 Real cfl_time_step(const Model& model, const State& state);
 
 }  // namespace karst

@@ -1,5 +1,5 @@
 #pragma once
-// SPH kernels with support radius h (W = 0 for r >= h), method.md §1.1.
+// SPH kernels with support radius h (W = 0 for r >= h), docs/method.md §1.1.
 #include "karst/core/types.hpp"
 
 #include <cmath>

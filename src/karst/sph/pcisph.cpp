@@ -12,9 +12,9 @@ namespace {
 /// a_i^p at the current pressures (sph/pressure_acceleration.hpp), then the prediction
 /// x*_i = x_i + dt (v_i + dt (a_other + a_p)) for the next density pass.
 ///
-/// Wall pressure [D]: method.md §4.3 writes the wall term with p_i alone; the variant it names,
-/// mirroring (p_ik = p_i), is needed because with p_i alone a wall-adjacent particle must carry
-/// about twice the hydrostatic pressure. Plain mirroring still assumes a flat pressure inside
+/// Wall pressure [D]: docs/method.md §4.3 writes the wall term with p_i alone; the variant it
+/// names, mirroring (p_ik = p_i), is needed because with p_i alone a wall-adjacent particle must
+/// carry about twice the hydrostatic pressure. Plain mirroring still assumes a flat pressure inside
 /// the wall, so next to a side wall the particle loses the vertical gradient its missing fluid
 /// neighbours would have given, and a narrow column settles over rho0 g depth. So the mirrored
 /// pressure is extrapolated
@@ -80,7 +80,7 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     const PorousParticles& porous = state.porous.particles;
     const std::vector<Real>& psi = state.porous_scratch.psi;
 
-    // p starts at 0 every step (method.md §4.3). A warm start from the last step's pressure
+    // p starts at 0 every step (docs/method.md §4.3). A warm start from the last step's pressure
     // (signed update, p >= 0) was tried: it smooths the pressure but left a resting column
     // moving at 0.1-0.2 m/s RMS, so it is not used.
     f.p.assign(n, 0);
@@ -105,7 +105,7 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
             });
             s.fluid_porous.for_each(
                 i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
-            // Signed error, p clamped at 0 (method.md §4.3); the stopping test reads the
+            // Signed error, p clamped at 0 (docs/method.md §4.3); the stopping test reads the
             // compression, or the over-pressure p_i could give back where the fluid expands.
             const Real e = rho - rho0;
             s.rho_err[i] = e > 0 ? e : std::min(-e, f.p[i] / s.delta[i]);
@@ -115,7 +115,7 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
             parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / rho0;
         pressure_acceleration_and_prediction(model, state, dt);
         ++report.iterations;
-        // Stopping rule (method.md §4.3; the paper's l.13 never ends).
+        // Stopping rule (docs/method.md §4.3; the paper's l.13 never ends).
         if (report.iterations >= fs.min_iterations &&
             report.max_density_error <= fs.max_density_error)
             break;

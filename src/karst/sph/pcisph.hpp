@@ -5,12 +5,12 @@
 
 namespace karst {
 
-/// Stage (method.md §4.3, Solenthaler & Pajarola 2009): the predict-correct loop. Starting from
-/// p = 0 it predicts x* with the non-pressure and pressure accelerations, predicts rho* (M7) at
-/// x*, updates p <- max(p + delta_i (rho* - rho0), 0) (delta_i: M8 per particle, see pcisph.cpp),
-/// and recomputes the pressure acceleration (walls with mirrored pressure), while (it < it_min or
-/// max_i max(rho*_i - rho0, 0) > eta_rho rho0) and it < it_max. Writes state.fluid.p (Pa) and
-/// scratch.a_pressure (m/s^2).
+/// Stage (docs/method.md §4.3, Solenthaler & Pajarola 2009): the predict-correct loop. Starting
+/// from p = 0 it predicts x* with the non-pressure and pressure accelerations, predicts rho* (M7)
+/// at x*, updates p <- max(p + delta_i (rho* - rho0), 0) (delta_i: M8 per particle, see
+/// pcisph.cpp), and recomputes the pressure acceleration (walls with mirrored pressure), while (it
+/// < it_min or max_i max(rho*_i - rho0, 0) > eta_rho rho0) and it < it_max. Writes state.fluid.p
+/// (Pa) and scratch.a_pressure (m/s^2).
 PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real dt);
 
 }  // namespace karst

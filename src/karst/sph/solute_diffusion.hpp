@@ -1,5 +1,5 @@
 #pragma once
-// Solute diffusion among fluid particles (method.md §4.9, M18): the Cleary-Monaghan conduction
+// Solute diffusion among fluid particles (docs/method.md §4.9, M18): the Cleary-Monaghan conduction
 // operator applied as pairwise transfers of solute mass, so solute is conserved exactly.
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
