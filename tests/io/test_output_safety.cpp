@@ -148,4 +148,27 @@ TEST(OutputSafety, SigtermStopsAfterAStepAndLeavesStats) {
     for (const auto& e : fs::directory_iterator(out)) EXPECT_NE(e.path().extension(), ".tmp");
 }
 
+TEST(OutputSafety, EachOutputPartIsSwitchedByItsOwnKey) {
+    Sandbox box("parts");
+    std::ofstream(box.path / "block.json") << R"({
+      "name": "block", "particle_spacing": 0.1, "time": { "end": 0.1 },
+      "porous_solids": [{ "shape": { "type": "box", "min": [0,0,0], "max": [0.4,0.4,0.4] },
+        "constraints": [{ "kind": "fixed", "region": { "type": "box", "min": [-1,-1,-1], "max": [2,2,0] } }] }],
+      "walls": [{ "kind": "obstacle", "shape": { "type": "box", "min": [1,1,1], "max": [1.2,1.2,1.2] } }],
+      "poroelastic": { "time_step": 0.05 },
+      "output": { "fps": 20, "vtp": false, "porous": false, "mesh": true, "walls": false }
+    })";
+    const fs::path out = box.path / "out";
+    ASSERT_EQ(shell(karst() + " run " + (box.path / "block.json").string() + " --quiet --out " +
+                    out.string()),
+              0);
+    EXPECT_TRUE(fs::exists(out / "mesh_0002.vtu"));
+    EXPECT_FALSE(fs::exists(out / "porous_0000.vtp"));
+    EXPECT_FALSE(fs::exists(out / "boundary.vtp"));
+    const std::string pvd = read_text(out / "run.pvd");
+    EXPECT_NE(pvd.find("mesh_0002.vtu"), std::string::npos);
+    EXPECT_EQ(pvd.find("porous_"), std::string::npos);
+    EXPECT_EQ(pvd.find("boundary.vtp"), std::string::npos);
+}
+
 }  // namespace

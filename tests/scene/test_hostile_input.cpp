@@ -107,6 +107,24 @@ TEST(HostileInput, StepAndFrameCountsAreBounded) {
         "/output/fps");
 }
 
+TEST(HostileInput, AConstraintOrWetRegionThatSelectsNoParticleIsRefused) {
+    const std::string far = R"({"type": "box", "min": [5,5,5], "max": [6,6,6]})";
+    const std::string block = R"({"name":"t","particle_spacing":0.1,"porous_solids": [{
+        "shape": {"type": "box", "min": [0,0,0], "max": [0.4,0.4,0.4]},)";
+    EXPECT_EQ(test::refuse_scene(block + R"("constraints": [{"kind": "fixed", "region": )" + far +
+                                 "}]}]}")
+                  .path,
+              "/porous_solids/0/constraints/0/region");
+    EXPECT_EQ(test::refuse_scene(block + R"("wet_regions": [{"saturation": 1, "region": )" + far +
+                                 "}]}]}")
+                  .path,
+              "/porous_solids/0/wet_regions/0/region");
+    // Within 3/4 of a spacing of a particle still selects (the Biot constraints reach as far).
+    const std::string touching = R"({"type": "box", "min": [-1,-1,-1], "max": [2,2,-0.02]})";
+    EXPECT_NO_THROW(build_model(parse_scene(
+        block + R"("constraints": [{"kind": "fixed", "region": )" + touching + "}]}]}")));
+}
+
 TEST(HostileInput, TheSceneNameStaysInsideTheOutputFolder) {
     for (const char* name : {"../x", "/abs/path", "a/b", "..", ".", "a\\\\b", "x\\u0001"}) {
         const SceneError e = test::refuse_scene(

@@ -16,7 +16,7 @@ FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings, bool over
     : m_folder(std::move(dir), overwrite), m_settings(settings) {}
 
 void FrameWriter::write_boundary(const WallParticles& walls) {
-    if (!m_settings.vtp || walls.size() == 0) return;
+    if (!m_settings.walls || walls.size() == 0) return;
     PointSet points{walls.x, {}};
     points.add_scalar("psi", walls.psi);
     m_folder.write("boundary.vtp", vtp_bytes(points, m_settings.compress));
@@ -25,7 +25,11 @@ void FrameWriter::write_boundary(const WallParticles& walls) {
 
 void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
     const int frame = frames();
-    if (parts.fluid) {
+    const bool fluid_part = parts.fluid && (m_settings.vtp || m_settings.ply);
+    const bool mesh = parts.mesh && m_settings.mesh;
+    const bool porous = parts.porous && m_settings.porous;
+    const bool cracks = parts.cracks && !parts.cracks->polygons.empty() && m_settings.cracks;
+    if (fluid_part) {
         const FluidParticles& fluid = *parts.fluid;
         PointSet points{fluid.x, {}};
         points.add_vector("velocity", fluid.v);
@@ -47,22 +51,21 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         if (m_settings.ply)
             m_folder.write(fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
     }
-    if (parts.mesh && m_settings.vtp)
+    if (mesh)
         m_folder.write(fmt::format("mesh_{:04d}.vtu", frame),
                        vtu_bytes(parts.mesh->nodes, parts.mesh->tets, m_settings.compress));
     m_log.push_back(log);
-    if (parts.porous && m_settings.vtp)
+    if (porous)
         m_folder.write(fmt::format("porous_{:04d}.vtp", frame),
                        vtp_bytes(*parts.porous, m_settings.compress));
-    const bool cracks = parts.cracks && !parts.cracks->polygons.empty();
-    if (cracks && m_settings.vtp)
+    if (cracks)
         m_folder.write(fmt::format("cracks_{:04d}.vtp", frame),
                        vtp_polygons_bytes(parts.cracks->vertices, parts.cracks->polygons,
                                           m_settings.compress));
-    m_written.push_back(
-        {parts.fluid != nullptr, parts.mesh != nullptr, parts.porous != nullptr, cracks});
+    m_written.push_back({fluid_part && m_settings.vtp, mesh, porous, cracks});
 
-    if (m_settings.vtp) {
+    if (m_has_boundary || m_settings.vtp || m_settings.mesh || m_settings.porous ||
+        m_settings.cracks) {
         // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles, 4 cracks.
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {

@@ -196,7 +196,7 @@ void append_arrays(PointSet& into, const PointSet& local) {
 
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
                        const BiotFields& fields, const PorousMaterial& material,
-                       const std::vector<Mat3>& node_tensors) {
+                       const std::vector<Mat3>& node_tensors, bool feedback) {
     const Index offset = Index(frame.nodes.x.size());
     const Index n = mesh.node_count();
     const NodalStress stress = nodal_stress(mesh, problem.material, fields);
@@ -204,13 +204,14 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
     std::vector<Real> crack(n);
     std::vector<Mat3> permeability(n);
     for (Index a = 0; a < n; ++a) {
-        permeability[a] = pore.permeability_scale[a] * node_tensors[a];
+        permeability[a] = (feedback ? pore.permeability_scale[a] : Real(1)) * node_tensors[a];
         crack[a] = stress.principal[a][0] / material.tensile_strength;
     }
     PointSet local;
     local.add_vector("displacement", fields.u);
     local.add_scalar("pore_pressure", fields.p);
-    local.add_scalar("porosity", pore.porosity);
+    local.add_scalar("porosity",
+                     feedback ? pore.porosity : std::vector<Real>(n, material.porosity));
     local.add_symmetric_tensor("permeability", permeability);
     local.add_symmetric_tensor("effective_stress", stress.effective);
     local.add_vector("principal_stress", stress.principal);

@@ -61,11 +61,12 @@ void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMater
                       std::vector<Real>& assembled_scale);
 
 /// Appends the mesh (nodes at `mesh.nodes`, tets) to `frame`, with the point arrays
-/// displacement, pore_pressure, porosity (M23), permeability (M24, 6 components),
-/// effective_stress (6), principal_stress (3) and crack_candidate (sigma'_1 / sigma_t, M25).
+/// displacement, pore_pressure, porosity and permeability (6 components) as the pores use them
+/// (the call's M23 and M24 with `feedback`, else the rest values phi0 and K0), effective_stress
+/// (6), principal_stress (3) and crack_candidate (sigma'_1 / sigma_t, M25).
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
                        const BiotFields& fields, const PorousMaterial& material,
-                       const std::vector<Mat3>& node_tensors);
+                       const std::vector<Mat3>& node_tensors, bool feedback);
 
 /// Appends the arrays of `local` to those of `into` (by name), creating them for the first solid.
 void append_arrays(PointSet& into, const PointSet& local);

@@ -301,7 +301,8 @@ void append_structure_meshes(const Model& model, State& state, MeshFrame& frame)
     for (size_t slot = 0; slot < state.structures.structures.size(); ++slot) {
         const Structure& s = state.structures.structures[slot];
         append_mesh_frame(frame, s.mesh, solver_of(model, state, slot).problem(), s.fields,
-                          model.scene.porous_solids[s.solid].material, s.node_tensors);
+                          model.scene.porous_solids[s.solid].material, s.node_tensors,
+                          model.scene.poroelastic.permeability_feedback);
     }
 }
 

@@ -222,6 +222,8 @@ Scene parse_scene(const std::string& text) {
     s.fracture.max_cracks_per_call = doc["fracture"]["max_cracks_per_call"];
     s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"],
     s.output.ply = doc["output"]["ply"], s.output.compress = doc["output"]["compress"];
+    s.output.porous = doc["output"]["porous"], s.output.mesh = doc["output"]["mesh"];
+    s.output.walls = doc["output"]["walls"], s.output.cracks = doc["output"]["cracks"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];
     return s;

@@ -153,7 +153,8 @@ struct OutputSettings {
     Real fps{};
     bool vtp{};
     bool ply{};
-    bool compress{};  ///< zlib blocks in the VTK frames
+    bool porous{}, mesh{}, walls{}, cracks{};  ///< which VTK parts are written
+    bool compress{};                           ///< zlib blocks in the VTK frames
 };
 
 struct Scene {

@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 #include <limits>
 #include <numeric>
@@ -100,6 +101,29 @@ void check_particle_budget(const Scene& s) {
                         have / 1e9),
             fmt::format("{} m: about {:.3g} million particles needing about {:.3g} GB", dx,
                         total / 1e6, need / 1e9));
+}
+
+/// A constraint or wet region that selects none of its solid's particles is a mistake (a fixed
+/// region that missed its block lets it fly away): refused. Constraints select the nodes within
+/// 3/4 dx of their region (pfem/biot_setup.cpp), wet regions the particles inside.
+void check_regions_select_particles(const Model& m) {
+    for (const PorousBody& body : m.porous) {
+        const PorousSolid& solid = m.scene.porous_solids[body.solid];
+        auto selects = [&](const Shape& region, Real reach) {
+            return std::any_of(body.rest_x.begin(), body.rest_x.end(),
+                               [&](const Vec3& x) { return region.signed_distance(x) <= reach; });
+        };
+        const std::string found = fmt::format(
+            "a region that selects none of the solid's {} particles", body.rest_x.size());
+        for (const Constraint& c : solid.constraints)
+            if (!selects(c.region, 0.75 * m.dx))
+                throw SceneError(c.path + "/region",
+                                 "a region reaching the solid (within 0.75 spacings)", found);
+        for (size_t w = 0; w < solid.wet_regions.size(); ++w)
+            if (!selects(solid.wet_regions[w].region, 0))
+                throw SceneError(fmt::format("{}/wet_regions/{}/region", solid.path, w),
+                                 "a region holding some of the solid's particles", found);
+    }
 }
 
 /// A run of more steps than this is a scene error (a step of 1e-300 s), not a long run.
@@ -371,6 +395,7 @@ Model build_model(const Scene& scene) {
                     fmt::format("a particle outside it at {}", fmt::streamed(x.transpose())));
     m.grid = UniformGrid(m.domain, m.h);
     compute_wall_volumes(m, wall_layers);
+    check_regions_select_particles(m);
     set_up_porous_materials(m);
     check_biot_setup(m);
     return m;
