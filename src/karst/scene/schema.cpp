@@ -193,10 +193,15 @@ std::vector<KeySpec> make_schema() {
         key("/porous_solids/[]/material/initial_saturation", T::Number, "", closed(0, 1.2), 0.0,
             "Saturation S at t = 0 outside the wet regions."),
         key("/porous_solids/[]/material/dissolution_porosity", T::Number, "", closed(0, 1), 0.6,
-            "phi_diss of docs/method.md §4.8: particles at least this porous dissolve once "
-            "saturated."),
+            "phi_diss of docs/method.md §4.8. A porous particle dissolves into muddy fluid (its "
+            "grains become the fluid's solute) when all hold: porosity >= dissolution_porosity, "
+            "saturation >= dissolution_saturation, and open water touches it (fluid within h, none "
+            "closer than 0.6 dx). With the default 0.6, a material of porosity below 0.6 never "
+            "dissolves; scenes/dissolving_mound.json shows one that does."),
         key("/porous_solids/[]/material/dissolution_saturation", T::Number, "", closed(0.5, 2),
-            0.98, "S_diss of docs/method.md §4.8."),
+            0.98,
+            "S_diss of docs/method.md §4.8: the saturation at which a porous-enough "
+            "particle dissolves (see dissolution_porosity)."),
         key("/porous_solids/[]/material/absorption_factor", T::Number, "", closed(0, 1e3), 1.0,
             "chi_abs of M15: scales the permeability of fluid-porous pairs (how fast the surface "
             "absorbs)."),

@@ -227,6 +227,22 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
               {"solute_final", final_totals.solute},
               {"grains_initial", initial.grains},
               {"grains_final", final_totals.grains}}},
+            {"mass_meaning",
+             {{"unit", "kg"},
+              {"water",
+               "all water: in the fluid particles (their mass less any grains) plus in "
+               "the pores; conserved up to fluid that left the domain"},
+              {"absorbed",
+               "net water the pores took from the fluid by pore flow over the run; "
+               "absorbed_final - absorbed_initial differs from it by the remnants "
+               "of drained fluid particles given to the pores and the pore water "
+               "of porous particles that dissolved or left the domain"},
+              {"absorbed_initial", "water in the pores at the start (initial saturation)"},
+              {"absorbed_final", "water in the pores at the end"},
+              {"solute", "dissolved grains carried by the fluid"},
+              {"grains",
+               "all grains: solid mass of the porous particles plus the solute; "
+               "conserved"}}},
             {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
             {"biot", biot_stats(pfem)},
             {"fracture", fracture_stats(state.structures.fracture)},
