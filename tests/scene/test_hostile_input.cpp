@@ -161,11 +161,14 @@ RunResult run_quietly(const std::string& json, const std::string& name) {
     return r;
 }
 
+/// A run of a scene kept in tests/data/bad_scenes.
+RunResult run_kept_scene(const std::string& file) {
+    return run_quietly(test::read_text(fs::path(KARST_SOURCE_DIR) / "tests/data/bad_scenes" / file),
+                       fs::path(file).stem().string());
+}
+
 TEST(HostileInput, AStepBelowDtMinStopsTheRun) {
-    const RunResult r =
-        run_quietly(test::read_text(fs::path(KARST_SOURCE_DIR) /
-                                    "tests/data/bad_scenes/rc0_dt_min_not_enforced.json"),
-                    "dt_min");
+    const RunResult r = run_kept_scene("rc0_dt_min_not_enforced.json");
     EXPECT_FALSE(r.ok);
     EXPECT_NE(r.failure.find("below /time/dt_min"), std::string::npos) << r.failure;
 }
@@ -198,10 +201,7 @@ TEST(HostileInput, NonFiniteBiotFieldsStopTheRunNamingTheNode) {
 }
 
 TEST(HostileInput, PoreWaterTooStiffForItsMobilityStopsTheRun) {
-    const RunResult r =
-        run_quietly(test::read_text(fs::path(KARST_SOURCE_DIR) /
-                                    "tests/data/bad_scenes/rc0_nan_biot_fixed_strain.json"),
-                    "stiff_pores");
+    const RunResult r = run_kept_scene("rc0_nan_biot_fixed_strain.json");
     EXPECT_FALSE(r.ok);
     EXPECT_NE(r.failure.find("sub-steps"), std::string::npos) << r.failure;
 }
