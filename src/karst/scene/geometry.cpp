@@ -102,27 +102,13 @@ std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, R
     return out;
 }
 
-double estimate_lattice_count(const Shape& shape, Real dx, Real lo, Real hi) {
-    const Real reach = std::isfinite(hi) ? std::max(hi, Real(0)) : 0;
-    LatticeIndex a, b;
-    lattice_range(shape.bounds(), reach, dx, a, b);
-    double lattice_points = 1;
-    for (int d = 0; d < 3; ++d) lattice_points *= double(b[d] - a[d] + 1);
-    if (lattice_points <= 2e8) {
-        // Exact count, streaming (no storage), one z-slice per task.
-        const Index slices = b[2] - a[2] + 1;
-        return deterministic_sum(slices, 0.0, [&](Index s) {
-            double n = 0;
-            for (std::int64_t j = a[1]; j <= b[1]; ++j)
-                for (std::int64_t i = a[0]; i <= b[0]; ++i) {
-                    const Real d = shape.signed_distance(lattice_point({i, j, a[2] + s}, dx));
-                    n += (d > lo && d <= hi);
-                }
-            return n;
-        });
-    }
-    // Too many to visit: count on a coarse 128^3 grid, giving every coarse cell that comes
-    // within its own half-diagonal of the band the full count of lattice points it holds.
+namespace {
+
+/// Lattice points in the band on a coarse 128^3 grid over the shape's box: every coarse cell
+/// that comes within its half-diagonal of the band counts in full (`upper`), or only cells
+/// wholly inside it do (!upper).
+double coarse_lattice_count(const Shape& shape, Real reach, Real lo, Real hi, double lattice_points,
+                            bool upper) {
     constexpr int n = 128;
     const Aabb box = shape.bounds().padded(reach);
     const Vec3 cell = (box.max - box.min) / n;
@@ -133,11 +119,40 @@ double estimate_lattice_count(const Shape& shape, Real dx, Real lo, Real hi) {
             for (int i = 0; i < n; ++i) {
                 const Vec3 x = box.min + cell.cwiseProduct(Vec3(i + 0.5, j + 0.5, k + 0.5));
                 const Real d = shape.signed_distance(x);
-                c += (d + half_diag > lo && d - half_diag <= hi);
+                c += upper ? (d + half_diag > lo && d - half_diag <= hi)
+                           : (d - half_diag > lo && d + half_diag <= hi);
             }
         return c;
     });
     return hits * lattice_points / (double(n) * n * n);
+}
+
+}  // namespace
+
+double estimate_lattice_count(const Shape& shape, Real dx, Real lo, Real hi, double enough) {
+    const Real reach = std::isfinite(hi) ? std::max(hi, Real(0)) : 0;
+    LatticeIndex a, b;
+    lattice_range(shape.bounds(), reach, dx, a, b);
+    double lattice_points = 1;
+    for (int d = 0; d < 3; ++d) lattice_points *= double(b[d] - a[d] + 1);
+    if (lattice_points > 2e8)
+        return coarse_lattice_count(shape, reach, lo, hi, lattice_points, true);
+    // A large box whose coarse lower bound already exceeds `enough` needs no exact count.
+    if (lattice_points > 1e7) {
+        const double at_least = coarse_lattice_count(shape, reach, lo, hi, lattice_points, false);
+        if (at_least > enough) return at_least;
+    }
+    // Exact count, streaming (no storage), one z-slice per task.
+    const Index slices = b[2] - a[2] + 1;
+    return deterministic_sum(slices, 0.0, [&](Index s) {
+        double n = 0;
+        for (std::int64_t j = a[1]; j <= b[1]; ++j)
+            for (std::int64_t i = a[0]; i <= b[0]; ++i) {
+                const Real d = shape.signed_distance(lattice_point({i, j, a[2] + s}, dx));
+                n += (d > lo && d <= hi);
+            }
+        return n;
+    });
 }
 
 }  // namespace karst

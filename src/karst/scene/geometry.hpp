@@ -5,6 +5,7 @@
 #include "karst/core/types.hpp"
 
 #include <array>
+#include <limits>
 #include <vector>
 
 namespace karst {
@@ -48,8 +49,10 @@ inline Vec3 lattice_point(const LatticeIndex& i, Real dx) {
 /// thickness t outside; (-t, 0] a skin inside.
 std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, Real hi);
 
-/// Upper estimate of the number of lattice points sample_lattice would return, computed
-/// without sampling at spacing dx (used to refuse scenes with too many particles).
-double estimate_lattice_count(const Shape& shape, Real dx, Real lo, Real hi);
+/// The number of lattice points sample_lattice would return, computed without storing them
+/// (used to refuse scenes with too many particles): exact up to 2e8 points in the shape's box, an
+/// upper estimate beyond; a lower bound above `enough` when that settles it without counting.
+double estimate_lattice_count(const Shape& shape, Real dx, Real lo, Real hi,
+                              double enough = std::numeric_limits<double>::infinity());
 
 }  // namespace karst

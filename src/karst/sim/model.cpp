@@ -76,14 +76,20 @@ void check_particle_budget(const Scene& s) {
     for (const Wall& w : s.walls)
         check_lattice_extent(w.shape, dx, w.layers * dx, w.path + "/shape");
     double fluid = 0, porous = 0, walls = 0;
-    for (const FluidBlock& b : s.fluid_blocks)
-        fluid += estimate_lattice_count(b.shape, dx, -inf, 0);
-    for (const PorousSolid& p : s.porous_solids)
-        porous += estimate_lattice_count(p.shape, dx, -inf, 0);
+    // Each loop stops once the cap is passed: a scene of thousands of blocks is refused at once.
+    for (const FluidBlock& b : s.fluid_blocks) {
+        if (fluid > k_max_particles) break;
+        fluid += estimate_lattice_count(b.shape, dx, -inf, 0, k_max_particles - fluid);
+    }
+    for (const PorousSolid& p : s.porous_solids) {
+        if (fluid + porous > k_max_particles) break;
+        porous += estimate_lattice_count(p.shape, dx, -inf, 0, k_max_particles - fluid - porous);
+    }
     for (const Wall& w : s.walls) {
         if (fluid + porous + walls > k_max_particles) break;
         const auto [lo, hi] = wall_band(w, dx);
-        walls += estimate_lattice_count(w.shape, dx, lo, hi);
+        walls +=
+            estimate_lattice_count(w.shape, dx, lo, hi, k_max_particles - fluid - porous - walls);
     }
     const double total = fluid + porous + walls;
     if (total > k_max_particles)
@@ -91,8 +97,8 @@ void check_particle_budget(const Scene& s) {
             "/particle_spacing",
             fmt::format("a spacing giving at most {:g} million particles", k_max_particles / 1e6),
             fmt::format("{} m, which gives about {:.3g} million", dx, total / 1e6));
-    const double need =
-        k_bytes_per_sph_particle * (fluid + walls) + k_bytes_per_porous_particle * porous;
+    const double need = k_bytes_per_sph_particle * fluid + k_bytes_per_wall_particle * walls +
+                        k_bytes_per_porous_particle * porous;
     const double have = available_memory_bytes();
     if (need > have)
         throw SceneError(
