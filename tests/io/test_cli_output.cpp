@@ -17,9 +17,7 @@ namespace fs = std::filesystem;
 using karst::test::read_text;
 
 int karst(const std::string& args) {
-    const int status =
-        std::system((std::string(KARST_BINARY) + " " + args + " 2>/dev/null").c_str());
-    return WEXITSTATUS(status);
+    return karst::test::exit_code_of(std::string(KARST_BINARY) + " " + args);
 }
 
 const char* k_tiny = R"({
@@ -30,15 +28,7 @@ const char* k_tiny = R"({
   "output": { "fps": 50, "ply": true }
 })";
 
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("karst_test_" + name)) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-};
+using karst::test::TempDir;
 
 TEST(Cli, WritesCompleteOutputFolder) {
     TempDir dir("cli");

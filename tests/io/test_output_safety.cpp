@@ -24,27 +24,16 @@ const char* k_small = R"({
   "output": { "fps": 50 }
 })";
 
-struct Sandbox {
-    fs::path path;
-    explicit Sandbox(const std::string& name)
-        : path(fs::temp_directory_path() / ("karst_test_" + name)) {
-        fs::remove_all(path);
-        fs::create_directories(path);
+/// A temporary folder holding the small scene.
+struct Sandbox : karst::test::TempDir {
+    explicit Sandbox(const std::string& name) : TempDir(name) {
         std::ofstream(path / "small.json") << k_small;
     }
-    ~Sandbox() { fs::remove_all(path); }
     std::string scene() const { return (path / "small.json").string(); }
 };
 
-/// Runs a shell command; its exit code, and what it printed on stderr in `err`.
 int shell(const std::string& command, std::string* err = nullptr) {
-    // One file per test process: CTest runs the tests of this file side by side.
-    const fs::path log =
-        fs::temp_directory_path() / ("karst_test_stderr_" + std::to_string(getpid()) + ".txt");
-    const int status = std::system((command + " 2>" + log.string() + " >/dev/null").c_str());
-    if (err) *err = read_text(log);
-    fs::remove(log);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return karst::test::exit_code_of(command, err);
 }
 
 std::string karst() {

@@ -208,10 +208,8 @@ TEST(HostileInput, PoreWaterTooStiffForItsMobilityStopsTheRun) {
 
 /// Exit code of the karst binary on `args`, killed after `seconds` (124 then).
 int karst_exit_code(const std::string& args, int seconds) {
-    const std::string command =
-        "timeout " + std::to_string(seconds) + " " + KARST_BINARY + " " + args + " >/dev/null 2>&1";
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return test::exit_code_of("timeout " + std::to_string(seconds) + " " + KARST_BINARY + " " +
+                              args);
 }
 
 TEST(HostileInput, EveryKeptFuzzCaseIsRefusedByCheck) {

@@ -240,9 +240,10 @@ Scene load_scene_file(const std::string& path) {
                                                     : "not a regular file";
         throw SceneError("", "a scene file (JSON)", fmt::format("{} at '{}'", kind, path));
     }
-    if (fs::exists(status) && fs::file_size(path, ec) > k_max_scene_bytes)
+    const std::uintmax_t bytes = fs::exists(status) ? fs::file_size(path, ec) : 0;
+    if (!ec && bytes > k_max_scene_bytes)
         throw SceneError("", fmt::format("a scene file of at most {} MB", k_max_scene_bytes >> 20),
-                         fmt::format("{} bytes at '{}'", fs::file_size(path, ec), path));
+                         fmt::format("{} bytes at '{}'", bytes, path));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw SceneError("", "a readable scene file", fmt::format("no file at '{}'", path));
     std::stringstream ss;

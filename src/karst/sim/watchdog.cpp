@@ -62,9 +62,8 @@ void check_scalars(const std::vector<Real>& values, const std::vector<std::int64
 
 void check_structures(const StructureState& structures, Stage stage, Real time) {
     for (const Structure& s : structures.structures) {
-        std::vector<std::int64_t> ids(s.node_id.begin(), s.node_id.end());
-        check_vectors(s.fields.u, ids, stage, time, "displacement (Biot)");
-        check_scalars(s.fields.p, ids, stage, time, "pore pressure (Biot)");
+        check_vectors(s.fields.u, s.node_id, stage, time, "displacement (Biot)");
+        check_scalars(s.fields.p, s.node_id, stage, time, "pore pressure (Biot)");
     }
 }
 
