@@ -23,6 +23,7 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
     elements.resize(mesh.tet_count());
     for (Index e = 0; e < mesh.tet_count(); ++e) elements[e] = p1_tet(mesh, e);
     split_dofs();
+    balance = LoadBalance(mesh.nodes, problem, u_dofs);
     if (options.polyhedral) {
         Real spacing = 0;  // gradient step 1e-4 of the mean edge length (M21: 1e-4 dx)
         for (const Tet& t : mesh.tets) spacing += (mesh.nodes[t[1]] - mesh.nodes[t[0]]).norm();
@@ -107,7 +108,8 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
     // change, the two starts agree. So a call whose loads and p^n are those of the previous
     // call's last mechanics solve, from the u that solve returned (a poroelastic-only run
     // under steady loads), has that u as its predictor and skips the solve.
-    const Vector rhs_predictor = u_dofs.gather_free(f_ext + Q * p) - elastic_lift;
+    Vector rhs_predictor = u_dofs.gather_free(f_ext + Q * p) - elastic_lift;
+    balance.apply(rhs_predictor);
     const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() &&
                                rhs_predictor == last_elastic_rhs && u == last_elastic_u;
     if (!as_last_solve && u_dofs.free_count > 0)
@@ -132,7 +134,8 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
         report.p_change.push_back(relative_change(p_next - p_n, p - p_n));
         if (accelerate) p_next = anderson.next(p, p_next);
         // 2. Mechanics with p frozen: K u = f_ext + Q p.
-        const Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
+        Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
+        balance.apply(rhs_u);
         Vector u_next = u;
         if (u_dofs.free_count > 0)
             u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);

@@ -50,6 +50,12 @@ struct BiotProblem {
     Vec3 gravity = Vec3::Zero();         ///< m/s^2
     /// A fragment without anchors: add eps diag(K) to remove the six rigid modes (§5.3).
     bool free_body = false;
+    /// The nodes of each piece (tets joined by faces) that some rigid motion leaves untouched by
+    /// the fixed nodes (none: an island left by dissolution, an anchored ledge in the air). Its
+    /// loads are balanced against those motions before each mechanics solve, so eps diag(K)
+    /// holds it in place, as its anchored fragment is, instead of a net load moving it by
+    /// |f| / (eps K). With free_body and no pieces, the whole mesh is one piece.
+    std::vector<std::vector<Index>> unheld_pieces;
     Real rigid_mode_spring = 1e-8;
 };
 

@@ -2,6 +2,7 @@
 // The Biot solver's assembled state (private to pfem/biot*.cpp): the matrices of the weak form
 // (biot.cpp's header states it), the free/prescribed split and the linear solvers.
 #include "karst/pfem/biot.hpp"
+#include "karst/pfem/load_balance.hpp"
 #include "karst/pfem/p1_tet.hpp"
 #include "karst/pfem/polyhedral_elements.hpp"
 #include "karst/pfem/sparse_linear.hpp"
@@ -36,6 +37,8 @@ struct BiotSolver::Impl {
     bool mobility_changed = true;
     Real flow_dt = -1;
     Real t_assembly = 0, t_elastic_factor = 0;
+
+    LoadBalance balance;  // the unheld pieces' loads against their rigid modes
 
     Impl(const TetMesh& m, BiotProblem p, BiotOptions o);
     /// Systems AMG over the free displacement rows: each row keeps its component.

@@ -3,6 +3,8 @@
 #include "karst/pfem/rigid_modes.hpp"
 
 #include "karst/core/timer.hpp"
+#include "karst/pfem/face_links.hpp"
+#include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/porosity.hpp"
 
 #include <algorithm>
@@ -109,6 +111,29 @@ BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, con
     return b;
 }
 
+std::vector<std::vector<Index>> unheld_pieces(const TetMesh& mesh,
+                                              std::span<const std::uint8_t> fixed) {
+    Index count = 0;
+    const std::vector<Index> piece_of = tet_components(mesh.tet_count(), face_links(mesh), count);
+    std::vector<std::pair<Index, Index>> member;  // (piece, node), once each after the sort
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        for (Index a : mesh.tets[e]) member.emplace_back(piece_of[e], a);
+    std::sort(member.begin(), member.end());
+    member.erase(std::unique(member.begin(), member.end()), member.end());
+    std::vector<std::vector<Index>> unheld;
+    for (size_t begin = 0, end = 0; begin < member.size(); begin = end) {
+        std::vector<Index> piece;
+        std::vector<Vec3> x;
+        std::vector<std::uint8_t> axes;
+        for (end = begin; end < member.size() && member[end].first == member[begin].first; ++end) {
+            const Index a = member[end].second;
+            piece.push_back(a), x.push_back(mesh.nodes[a]), axes.push_back(fixed[a]);
+        }
+        if (free_rigid_modes(x, axes).cols() > 0) unheld.push_back(std::move(piece));
+    }
+    return unheld;
+}
+
 BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                          const std::vector<Mat3>& node_tensors) {
     BiotProblem p;
@@ -134,9 +159,10 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     p.nodal_force = std::move(values.nodal_force);
     p.prescribed_u = std::move(values.prescribed_u);
     p.drained_pressure = std::move(values.drained_pressure);
-    // Without anchors, or anchored only at a point or along a line (a piece left by fracture),
-    // the rigid-mode spring keeps the elasticity invertible.
-    p.free_body = !holds_rigid_modes(mesh.nodes, p.fixed);
+    // Without anchors, or anchored only at a point or along a line (a piece left by fracture or
+    // an island left by dissolution), the rigid-mode spring keeps the elasticity invertible.
+    p.unheld_pieces = unheld_pieces(mesh, p.fixed);
+    p.free_body = !holds_rigid_modes(mesh.nodes, p.fixed) || !p.unheld_pieces.empty();
     return p;
 }
 

@@ -9,6 +9,7 @@
 #include "karst/sim/model.hpp"
 
 #include <algorithm>
+#include <span>
 
 namespace karst {
 
@@ -33,6 +34,11 @@ inline bool has_time_table(const PorousSolid& solid) {
     return std::any_of(solid.constraints.begin(), solid.constraints.end(),
                        [](const Constraint& c) { return !c.table.rows.empty(); });
 }
+
+/// The nodes of each piece of `mesh` (tets joined by faces) that some rigid motion leaves
+/// untouched by its `fixed` nodes (pfem/rigid_modes.hpp: free_rigid_modes).
+std::vector<std::vector<Index>> unheld_pieces(const TetMesh& mesh,
+                                              std::span<const std::uint8_t> fixed);
 
 /// The Biot problem of `solid` on `mesh`, whose nodes are world positions: mobility from the
 /// nodal tensors K0, the scene's constraints (fixed, drained, traction) at t = 0, and anchors

@@ -170,16 +170,22 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
     out.mesh.boundary = boundary_faces(out.mesh.tets);
     if (!out.mesh.tet_polyhedron.empty())
         out.mesh.tet_polyhedron = regroup_polyhedra(mesh, out.links);
-    DisjointSets parts(ne);
-    for (const ElementLink& l : out.links) parts.join(l.a, l.b);
-    out.component.resize(ne);
-    std::vector<Index> number(ne, -1);
-    for (Index e = 0; e < ne; ++e) {
-        const Index root = parts.find(e);
-        if (number[root] < 0) number[root] = out.components++;
-        out.component[e] = number[root];
-    }
+    out.component = tet_components(ne, out.links, out.components);
     return out;
+}
+
+std::vector<Index> tet_components(Index tet_count, std::span<const ElementLink> links,
+                                  Index& count) {
+    DisjointSets parts(tet_count);
+    for (const ElementLink& l : links) parts.join(l.a, l.b);
+    std::vector<Index> component(tet_count), number(tet_count, -1);
+    count = 0;
+    for (Index e = 0; e < tet_count; ++e) {
+        const Index root = parts.find(e);
+        if (number[root] < 0) number[root] = count++;
+        component[e] = number[root];
+    }
+    return component;
 }
 
 Index cut_sliver_bridges(const TetMesh& mesh, std::span<const ElementLink> links,

@@ -26,6 +26,11 @@ struct MeshSplit {
 MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
                      std::span<const char> broken, Real offset);
 
+/// Per tet, its connected component over `links`, numbered 0, 1, ... in order of their lowest
+/// tet; `count` gets the number of components.
+std::vector<Index> tet_components(Index tet_count, std::span<const ElementLink> links,
+                                  Index& count);
+
 /// Cuts the links by which a tet of volume below `min_volume` (a sliver, with next to no
 /// stiffness) would join two pieces that are apart otherwise: the sliver goes with the piece of
 /// its first solid neighbour. A piece hanging on a sliver has a singular elasticity. Returns the

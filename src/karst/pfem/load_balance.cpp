@@ -1,0 +1,117 @@
+#include "karst/pfem/load_balance.hpp"
+
+#include "karst/pfem/rigid_modes.hpp"
+
+#include <Eigen/QR>
+
+#include <numeric>
+
+namespace karst {
+
+namespace {
+
+/// [D] A group whose dense basis would pass this many entries (a mesh shattered into thousands
+/// of hinged pieces) has all its loads removed instead: it stays where its anchor holds it.
+constexpr double k_max_basis_entries = 2e7;
+
+/// One piece's free modes, row by row: (group row, the k modes' values there).
+struct PieceModes {
+    Eigen::Index first_column = 0, count = 0;
+    std::vector<std::pair<int, Eigen::VectorXd>> values;
+};
+
+}  // namespace
+
+LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& problem,
+                         const DofSplit& dofs) {
+    const Index n = Index(nodes.size());
+    std::vector<std::vector<Index>> pieces = problem.unheld_pieces;
+    if (problem.free_body && pieces.empty()) {
+        pieces.emplace_back(n);
+        std::iota(pieces.back().begin(), pieces.back().end(), Index(0));
+    }
+    // Groups: union-find over the pieces, joined where they share a node.
+    std::vector<Index> group(pieces.size()), owner(n, -1);
+    std::vector<int> pieces_at(n, 0);
+    std::iota(group.begin(), group.end(), Index(0));
+    const auto root = [&](Index g) {
+        while (group[g] != g) g = group[g] = group[group[g]];
+        return g;
+    };
+    for (size_t k = 0; k < pieces.size(); ++k)
+        for (Index a : pieces[k]) {
+            ++pieces_at[a];
+            if (owner[a] < 0) owner[a] = Index(k);
+            const Index r1 = root(owner[a]), r2 = root(Index(k));
+            group[std::max(r1, r2)] = std::min(r1, r2);
+        }
+
+    std::vector<std::vector<int>> rows(pieces.size());
+    std::vector<std::vector<PieceModes>> members(pieces.size());
+    std::vector<Eigen::Index> columns(pieces.size(), 0);
+    std::vector<int> local(dofs.free_index.size(), -1);
+    const auto add_row = [&](Index g, int row) {
+        if (local[row] < 0) local[row] = int(rows[g].size()), rows[g].push_back(row);
+        return local[row];
+    };
+    for (size_t k = 0; k < pieces.size(); ++k) {
+        std::vector<Vec3> x;
+        std::vector<std::uint8_t> fixed;
+        for (Index a : pieces[k]) x.push_back(nodes[a]), fixed.push_back(problem.fixed[a]);
+        const Eigen::Matrix<Real, 6, Eigen::Dynamic> free = free_rigid_modes(x, fixed);
+        if (free.cols() == 0) continue;
+        const RigidFrame frame(x);
+        const Index g = root(Index(k));
+        PieceModes piece{columns[g], free.cols(), {}};
+        columns[g] += free.cols();
+        // A node shared with another piece (a hinge) follows neither piece's modes alone: its
+        // rows get a column each below, so that the span holds the hinged motions.
+        for (size_t i = 0; i < x.size(); ++i)
+            for (int d = 0; d < 3; ++d)
+                if (const int row = dofs.free_index[3 * pieces[k][i] + d];
+                    row >= 0 && pieces_at[pieces[k][i]] == 1)
+                    piece.values.emplace_back(add_row(g, row),
+                                              (frame.row(x[i], d) * free).transpose());
+        members[g].push_back(std::move(piece));
+    }
+    for (Index a = 0; a < n; ++a)
+        for (int d = 0; d < 3 && pieces_at[a] > 1; ++d)
+            if (const int row = dofs.free_index[3 * a + d]; row >= 0) {
+                const Index g = root(owner[a]);
+                members[g].push_back(
+                    {columns[g]++, 1, {{add_row(g, row), Eigen::VectorXd::Ones(1)}}});
+            }
+
+    for (size_t g = 0; g < pieces.size(); ++g) {
+        if (rows[g].empty()) continue;
+        Group out;
+        const Eigen::Index m = Eigen::Index(rows[g].size());
+        out.rows = std::move(rows[g]);
+        if (double(m) * double(columns[g]) > k_max_basis_entries) {
+            out.all_rows = true;
+        } else {
+            Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, columns[g]);
+            for (const PieceModes& piece : members[g])
+                for (const auto& [at, v] : piece.values)
+                    R.block(at, piece.first_column, 1, piece.count) = v.transpose();
+            const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(R);
+            out.basis = qr.householderQ() * Eigen::MatrixXd::Identity(m, qr.rank());
+        }
+        m_groups.push_back(std::move(out));
+    }
+}
+
+void LoadBalance::apply(Vector& rhs) const {
+    for (const Group& g : m_groups) {
+        if (g.all_rows) {
+            for (int row : g.rows) rhs[row] = 0;
+            continue;
+        }
+        Eigen::VectorXd v(g.rows.size());
+        for (size_t i = 0; i < g.rows.size(); ++i) v[Eigen::Index(i)] = rhs[g.rows[i]];
+        v -= g.basis * (g.basis.transpose() * v);
+        for (size_t i = 0; i < g.rows.size(); ++i) rhs[g.rows[i]] = v[Eigen::Index(i)];
+    }
+}
+
+}  // namespace karst
