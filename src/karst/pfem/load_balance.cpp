@@ -1,5 +1,6 @@
 #include "karst/pfem/load_balance.hpp"
 
+#include "karst/core/disjoint_sets.hpp"
 #include "karst/pfem/rigid_modes.hpp"
 
 #include <Eigen/QR>
@@ -25,26 +26,23 @@ struct PieceModes {
 LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& problem,
                          const DofSplit& dofs) {
     const Index n = Index(nodes.size());
-    std::vector<std::vector<Index>> pieces = problem.unheld_pieces;
-    if (problem.free_body && pieces.empty()) {
-        pieces.emplace_back(n);
-        std::iota(pieces.back().begin(), pieces.back().end(), Index(0));
+    std::vector<std::vector<Index>> whole;
+    if (problem.free_body && problem.unheld_pieces.empty()) {
+        whole.emplace_back(n);
+        std::iota(whole[0].begin(), whole[0].end(), Index(0));
     }
-    // Groups: union-find over the pieces, joined where they share a node.
-    std::vector<Index> group(pieces.size()), owner(n, -1);
+    const std::vector<std::vector<Index>>& pieces = whole.empty() ? problem.unheld_pieces : whole;
+    // Groups: the pieces joined where they share a node.
+    DisjointSets groups(Index(pieces.size()));
+    std::vector<Index> owner(n, -1);
     std::vector<int> pieces_at(n, 0);
-    std::iota(group.begin(), group.end(), Index(0));
-    const auto root = [&](Index g) {
-        while (group[g] != g) g = group[g] = group[group[g]];
-        return g;
-    };
     for (size_t k = 0; k < pieces.size(); ++k)
         for (Index a : pieces[k]) {
             ++pieces_at[a];
             if (owner[a] < 0) owner[a] = Index(k);
-            const Index r1 = root(owner[a]), r2 = root(Index(k));
-            group[std::max(r1, r2)] = std::min(r1, r2);
+            groups.join(owner[a], Index(k));
         }
+    const auto root = [&](Index k) { return groups.find(k); };
 
     std::vector<std::vector<int>> rows(pieces.size());
     std::vector<std::vector<PieceModes>> members(pieces.size());

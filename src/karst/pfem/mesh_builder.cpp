@@ -18,6 +18,7 @@
 #include "karst/pfem/tet_mesh.hpp"
 
 #include "karst/core/check.hpp"
+#include "karst/core/disjoint_sets.hpp"
 #include "karst/core/parallel.hpp"
 
 #include <CGAL/Delaunay_triangulation_3.h>
@@ -31,7 +32,6 @@
 
 #include <functional>
 #include <numbers>
-#include <numeric>
 
 namespace karst {
 
@@ -57,19 +57,6 @@ using Regular =
 Vec3 to_vec(const K::Point_3& p) {
     return {p.x(), p.y(), p.z()};
 }
-
-struct UnionFind {
-    std::vector<Index> parent;
-    explicit UnionFind(Index n) : parent(n) { std::iota(parent.begin(), parent.end(), Index(0)); }
-    Index find(Index a) {
-        while (parent[a] != a) a = parent[a] = parent[parent[a]];
-        return a;
-    }
-    void join(Index a, Index b) {
-        a = find(a), b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);  // smallest root: deterministic ids
-    }
-};
 
 /// Per finite cell: node ids, circumcentre (orthocentre when weighted), squared (ortho)radius.
 struct Cells {
@@ -120,7 +107,7 @@ TetMesh mesh_from_cells(std::span<const Vec3> points, std::span<const Real> node
     });
 
     // M20: union-find over face-adjacent kept cells with nearly coincident centres.
-    UnionFind groups(n_cells);
+    DisjointSets groups(n_cells);
     for (Index c = 0; c < n_cells; ++c) {
         if (!kept[c]) continue;
         for (int k = 0; k < 4; ++k) {

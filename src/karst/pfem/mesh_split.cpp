@@ -1,25 +1,13 @@
 #include "karst/pfem/mesh_split.hpp"
 
+#include "karst/core/disjoint_sets.hpp"
+
 #include <algorithm>
 #include <numeric>
 
 namespace karst {
 
 namespace {
-
-/// Union-find over [0, n) with path halving; the root of a set is its smallest member.
-struct DisjointSets {
-    std::vector<Index> parent;
-    explicit DisjointSets(Index n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-    Index find(Index x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-    void join(Index a, Index b) {
-        a = find(a), b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-};
 
 /// Renumbers ids 0, 1, ... in order of first appearance.
 void compact_ids(std::vector<Index>& ids) {
