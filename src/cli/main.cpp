@@ -29,7 +29,8 @@ int main(int argc, char** argv) {
     std::string scene_path;
     karst::RunOptions run_options;
     std::string out_dir;
-    std::optional<double> end_time, fps;
+    std::optional<double> end_time, fps, checkpoint_every;
+    std::string resume_dir;
     CLI::App* run =
         app.add_subcommand("run", "Simulate a scene (the built-in dam break when none is given)");
     run->add_option("scene", scene_path, "Scene file (JSON)");
@@ -38,6 +39,14 @@ int main(int argc, char** argv) {
     run->add_option("--fps", fps, "Output frames per simulated second (overrides /output/fps)");
     run->add_option("--threads", run_options.threads, "Worker threads (0: all cores)");
     run->add_flag("--quiet", run_options.quiet, "No progress line");
+    run->add_option("--checkpoint-every", checkpoint_every,
+                    "Write a checkpoint every this many simulated seconds, at the end and when "
+                    "stopped by Ctrl-C or SIGTERM");
+    run->add_option("--checkpoint-keep", run_options.checkpoint_keep,
+                    "Newest checkpoints kept in the output folder (default 2)");
+    run->add_option("--resume", resume_dir,
+                    "Continue the run in this output folder from its newest checkpoint (same "
+                    "scene; --end-time may extend it)");
     run->add_flag("--overwrite", run_options.overwrite,
                   "Write into a non-empty output folder that no karst run wrote (only karst's "
                   "own file names are replaced)");
@@ -81,6 +90,8 @@ int main(int argc, char** argv) {
         }
         if (!out_dir.empty()) run_options.out_dir = out_dir;
         run_options.end_time = end_time, run_options.fps = fps;
+        run_options.checkpoint_every = checkpoint_every;
+        if (!resume_dir.empty()) run_options.resume = resume_dir;
         karst::catch_stop_signals();
         const karst::RunResult result = karst::run_simulation(read_scene(scene_path), run_options);
         if (result.stop_signal) {

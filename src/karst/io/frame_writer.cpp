@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -15,12 +16,30 @@ namespace fs = std::filesystem;
 FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings, bool overwrite)
     : m_folder(std::move(dir), overwrite), m_settings(settings) {}
 
+FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings, FrameHistory history)
+    : m_folder(std::move(dir), OutputFolder::Resume{}),
+      m_settings(settings),
+      m_history(std::move(history)) {
+    // Frame files are <part>_NNNN.<ext>; those numbered past the history are the killed run's.
+    const int kept = frames();
+    m_folder.remove_if([kept](const std::string& name) {
+        const size_t underscore = name.rfind('_'), dot = name.rfind('.');
+        if (underscore == std::string::npos || dot == std::string::npos || dot < underscore + 2)
+            return false;
+        const std::string digits = name.substr(underscore + 1, dot - underscore - 1);
+        if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+            return false;
+        const std::string ext = name.substr(dot);
+        return (ext == ".vtp" || ext == ".vtu" || ext == ".ply") && std::stoll(digits) >= kept;
+    });
+}
+
 void FrameWriter::write_boundary(const WallParticles& walls) {
     if (!m_settings.walls || walls.size() == 0) return;
     PointSet points{walls.x, {}};
     points.add_scalar("psi", walls.psi);
     m_folder.write("boundary.vtp", vtp_bytes(points, m_settings.compress));
-    m_has_boundary = true;
+    m_history.has_boundary = true;
 }
 
 void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
@@ -54,7 +73,7 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
     if (mesh)
         m_folder.write(fmt::format("mesh_{:04d}.vtu", frame),
                        vtu_bytes(parts.mesh->nodes, parts.mesh->tets, m_settings.compress));
-    m_log.push_back(log);
+    m_history.log.push_back(log);
     if (porous)
         m_folder.write(fmt::format("porous_{:04d}.vtp", frame),
                        vtp_bytes(*parts.porous, m_settings.compress));
@@ -62,22 +81,24 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         m_folder.write(fmt::format("cracks_{:04d}.vtp", frame),
                        vtp_polygons_bytes(parts.cracks->vertices, parts.cracks->polygons,
                                           m_settings.compress));
-    m_written.push_back({fluid_part && m_settings.vtp, mesh, porous, cracks});
+    m_history.written.push_back({fluid_part && m_settings.vtp, mesh, porous, cracks});
+    const std::vector<FrameLog>& rows = m_history.log;
+    const std::vector<FrameHistory::Written>& written = m_history.written;
+    const bool boundary = m_history.has_boundary;
 
-    if (m_has_boundary || m_settings.vtp || m_settings.mesh || m_settings.porous ||
-        m_settings.cracks) {
+    if (boundary || m_settings.vtp || m_settings.mesh || m_settings.porous || m_settings.cracks) {
         // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles, 4 cracks.
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {
-            if (m_written[f].fluid)
-                entries.push_back({m_log[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
-            if (m_has_boundary) entries.push_back({m_log[f].time, 1, "boundary.vtp"});
-            if (m_written[f].mesh)
-                entries.push_back({m_log[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
-            if (m_written[f].porous)
-                entries.push_back({m_log[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
-            if (m_written[f].cracks)
-                entries.push_back({m_log[f].time, 4, fmt::format("cracks_{:04d}.vtp", f)});
+            if (written[f].fluid)
+                entries.push_back({rows[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
+            if (boundary) entries.push_back({rows[f].time, 1, "boundary.vtp"});
+            if (written[f].mesh)
+                entries.push_back({rows[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
+            if (written[f].porous)
+                entries.push_back({rows[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
+            if (written[f].cracks)
+                entries.push_back({rows[f].time, 4, fmt::format("cracks_{:04d}.vtp", f)});
         }
         m_folder.write("run.pvd", pvd_bytes(entries));
     }
@@ -85,7 +106,7 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         "frame,time,dt,steps,particles,removed,density_error,mipps,speed_p99,max_speed,kinetic_"
         "energy,potential_energy,total_energy\n";
     for (int f = 0; f < frames(); ++f) {
-        const FrameLog& r = m_log[f];
+        const FrameLog& r = rows[f];
         csv += fmt::format(
             "{},{:.9g},{:.6g},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g}\n", f,
             r.time, r.dt, r.steps, r.particles, r.removed, r.density_error, r.mipps, r.speed_p99,

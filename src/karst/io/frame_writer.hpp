@@ -54,28 +54,38 @@ struct FrameParts {
     const CrackFrame* cracks = nullptr;  ///< written once some crack exists
 };
 
+/// The frames written so far: what run.pvd and log.csv list (a checkpoint keeps it).
+struct FrameHistory {
+    struct Written {
+        bool fluid = false, mesh = false, porous = false, cracks = false;
+    };
+    std::vector<FrameLog> log;
+    std::vector<Written> written;  ///< which parts each frame has
+    bool has_boundary = false;
+};
+
 class FrameWriter {
 public:
     /// Claims `dir` (io/output_folder.hpp: the files of an earlier run there are removed; a
     /// folder karst did not write is refused unless `overwrite`).
     FrameWriter(std::filesystem::path dir, const OutputSettings& settings, bool overwrite);
+    /// Continues the run that wrote `dir` after its frames in `history` (a resumed run): the
+    /// frame files it wrote after them are removed, the rest is kept.
+    FrameWriter(std::filesystem::path dir, const OutputSettings& settings, FrameHistory history);
     void write_boundary(const WallParticles& walls);
     /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu, porous_NNNN.vtp and cracks_NNNN.vtp as present, then
     /// run.pvd and log.csv anew.
     void write_frame(const FrameParts& parts, const FrameLog& log);
     void write_stats(const nlohmann::json& stats);
-    int frames() const { return int(m_log.size()); }
+    int frames() const { return int(m_history.log.size()); }
+    const FrameHistory& history() const { return m_history; }
+    OutputFolder& folder() { return m_folder; }
     const std::filesystem::path& dir() const { return m_folder.dir(); }
 
 private:
     OutputFolder m_folder;
     OutputSettings m_settings;
-    bool m_has_boundary = false;
-    std::vector<FrameLog> m_log;
-    struct Written {
-        bool fluid, mesh, porous, cracks;
-    };
-    std::vector<Written> m_written;  ///< which parts each frame has
+    FrameHistory m_history;
 };
 
 }  // namespace karst

@@ -50,6 +50,25 @@ OutputFolder::OutputFolder(fs::path dir, bool overwrite) : m_dir(std::move(dir))
     }
 }
 
+OutputFolder::OutputFolder(fs::path dir, Resume) : m_dir(std::move(dir)) {
+    std::ifstream in(m_dir / k_manifest);
+    if (!in)
+        throw SceneError("--resume", "a folder a karst run wrote (with its manifest)",
+                         fmt::format("no {} in '{}'", k_manifest, m_dir.string()));
+    std::error_code ec;
+    for (std::string name; std::getline(in, name);)
+        if (plain_name(name)) {
+            m_listed.insert(name);
+            fs::remove(m_dir / (name + ".tmp"), ec);  // a killed run's unfinished write
+        }
+}
+
+void OutputFolder::remove_if(const std::function<bool(const std::string&)>& pick) {
+    std::error_code ec;
+    for (const std::string& name : m_listed)
+        if (pick(name)) fs::remove(m_dir / name, ec), fs::remove(m_dir / (name + ".tmp"), ec);
+}
+
 void OutputFolder::write(const std::string& name, std::string_view bytes) {
     if (m_listed.insert(name).second) {
         std::ofstream manifest(m_dir / k_manifest, std::ios::app);

@@ -85,8 +85,10 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
                        : 0;
     Stopwatch factor_watch;
     // A dt within 1e-9 of the factorised one (a coupled run's dt_B, summed from its steps)
-    // reuses the factor.
-    if (mobility_changed || std::abs(dt - flow_dt) > 1e-9 * dt) factorise_flow(dt, L);
+    // reuses the factor, and a new factor for a changed mobility keeps that dt: the matrix's dt
+    // then depends on the state alone (flow_time_step()), not on when the solver was built.
+    const bool same_dt = std::abs(dt - flow_dt) <= 1e-9 * dt;
+    if (mobility_changed || !same_dt) factorise_flow(same_dt ? flow_dt : dt, L);
     report.seconds_flow_factorisation = factor_watch.seconds();
 
     Stopwatch watch;
@@ -174,6 +176,14 @@ void BiotSolver::set_mobility(std::vector<Mat3> mobility) {
     KARST_CHECK(mobility.size() == size_t(m_impl->mesh.tet_count()));
     m_impl->problem.mobility = std::move(mobility);
     m_impl->assemble_flow();
+}
+
+Real BiotSolver::flow_time_step() const {
+    return m_impl->flow_dt;
+}
+
+void BiotSolver::set_flow_time_step(Real dt) {
+    m_impl->flow_dt = dt, m_impl->mobility_changed = true;
 }
 
 void BiotSolver::set_extra_loads(const std::vector<Vec3>& loads) {

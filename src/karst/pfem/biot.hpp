@@ -117,6 +117,12 @@ public:
     /// New per-tet mobility (M24 feedback); H is reassembled at the next call.
     void set_mobility(std::vector<Mat3> mobility);
 
+    /// The step the flow matrix (S + L M + dt H) was last factorised for; calls whose dt is
+    /// within 1e-9 of it reuse that step in the matrix. A solver rebuilt for a run in progress
+    /// (a resume) is given it back, so that it factorises the matrix the run was using.
+    Real flow_time_step() const;
+    void set_flow_time_step(Real dt);
+
     /// Nodal loads (N, per node) added to the body force and the problem's own nodal_force from
     /// the next call on: the fluid's forces on a coupled fragment (docs/method.md §5.3).
     void set_extra_loads(const std::vector<Vec3>& loads);

@@ -188,6 +188,15 @@ NodalPoreState nodal_pore_state(const PorousMaterial& material, const BiotMateri
     return s;
 }
 
+void assemble_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material,
+                       const std::vector<Mat3>& node_tensors, const std::vector<Real>& tet_scale) {
+    std::vector<Mat3> mobility(mesh.tet_count());
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        mobility[e] =
+            (tet_scale[e] / material.darcy_viscosity) * tet_mean(mesh.tets[e], node_tensors);
+    solver.set_mobility(std::move(mobility));
+}
+
 void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material,
                       const std::vector<Mat3>& node_tensors, const std::vector<Real>& node_scale,
                       std::vector<Real>& assembled_scale) {
@@ -200,11 +209,7 @@ void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMater
         changed = changed || std::abs(tet_scale[e] / assembled_scale[e] - 1) > 0.01;
     }
     if (!changed) return;
-    std::vector<Mat3> mobility(mesh.tet_count());
-    for (Index e = 0; e < mesh.tet_count(); ++e)
-        mobility[e] =
-            (tet_scale[e] / material.darcy_viscosity) * tet_mean(mesh.tets[e], node_tensors);
-    solver.set_mobility(std::move(mobility));
+    assemble_mobility(solver, mesh, material, node_tensors, tet_scale);
     assembled_scale = std::move(tet_scale);
 }
 

@@ -59,6 +59,10 @@ struct NodalPoreState {
 NodalPoreState nodal_pore_state(const PorousMaterial& material, const BiotMaterial& biot,
                                 const NodalStress& stress, const std::vector<Real>& pressure);
 
+/// H from each tet's permeability scale k/k0 (M24): mobility scale K0 / eta per tet.
+void assemble_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMaterial& material,
+                       const std::vector<Mat3>& node_tensors, const std::vector<Real>& tet_scale);
+
 /// M24 into the Biot flow: each tet's permeability scale is the mean of its nodes'. H is
 /// reassembled (and the flow matrix refactorised) only when some tet's scale moved by over 1 %
 /// since the last assembly, whose scales `assembled_scale` keeps (all 1 at first).

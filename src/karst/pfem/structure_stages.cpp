@@ -44,10 +44,17 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     // poroelastic-only solid keeps gravity: consolidation under its weight is what it shows.
     if (!model.poroelastic_only()) problem.gravity = Vec3::Zero();
     e.solver.emplace(make_biot_solver(model, s.mesh, std::move(problem), state.structures.timings));
-    e.assembled_scale.assign(s.mesh.tet_count(), 1);
     e.mesh_version = s.mesh_version;
+    // The flow matrix the run was using: a new mesh starts from the problem's (scale 1); a solver
+    // rebuilt for a mesh it had already (a resumed run) takes the scales it was assembled with.
+    if (s.mobility_scale.size() != size_t(s.mesh.tet_count()))
+        s.mobility_scale.assign(s.mesh.tet_count(), 1);
+    else if (std::any_of(s.mobility_scale.begin(), s.mobility_scale.end(),
+                         [](Real k) { return k != 1; }))
+        assemble_mobility(*e.solver, s.mesh, solid.material, s.node_tensors, s.mobility_scale);
     refresh_mobility(*e.solver, s.mesh, solid.material, s.node_tensors, s.permeability_scale,
-                     e.assembled_scale);
+                     s.mobility_scale);
+    if (s.flow_time_step > 0) e.solver->set_flow_time_step(s.flow_time_step);
     return *e.solver;
 }
 
@@ -72,6 +79,7 @@ void build(const Model& model, State& state, size_t slot) {
     for (Index id : s.node_id) x.push_back(st.rest_x[id]);
     s.mesh = mesh_points(model, x, st.timings);
     s.mesh_version = st.next_mesh_version++;
+    s.mobility_scale.clear(), s.flow_time_step = -1;  // a new mesh's solver starts afresh
     s.links = face_links(s.mesh);
     const Index n = s.mesh.node_count();
     s.node_tensors.resize(n), s.fields.u.resize(n), s.fields.p.assign(n, 0),
@@ -236,6 +244,7 @@ void solve_structures(const Model& model, State& state, Real time, bool again) {
             s.u_from[a] = i >= 0 ? Vec3(p.x[i] - st.rest_x[s.node_id[a]]) : s.fields.u[a];
         }
         const BiotCallReport r = solver.advance(dt, s.fields);
+        s.flow_time_step = solver.flow_time_step();
         st.timings.factorisation += r.seconds_flow_factorisation,
             st.timings.iterations += r.seconds_iterations;
         ++(again ? st.timings.repeated_calls : st.timings.biot_calls);
@@ -287,7 +296,7 @@ bool feed_back_structures(const Model& model, State& state) {
         }
         s.permeability_scale = pore.permeability_scale;
         refresh_mobility(solver, s.mesh, material, s.node_tensors, s.permeability_scale,
-                         state.biot_cache.find(slot, s.mesh_version)->assembled_scale);
+                         s.mobility_scale);
     }
     if (stale)
         for (Index i = 0; i < p.size(); ++i)

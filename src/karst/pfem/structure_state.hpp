@@ -31,6 +31,11 @@ struct Structure {
     std::vector<Vec3> u_from;  ///< per node: u of the call before the last (the particles' start)
     std::vector<Mat3> node_tensors;        ///< K0 per node (body frame), m^2
     std::vector<Real> permeability_scale;  ///< per node: k/k0 of the last feedback (M24)
+    /// Per tet: the k/k0 the Biot flow matrix is assembled with; it follows permeability_scale
+    /// when a tet's mean moves by over 1 % (biot_setup.hpp). State, not cache: a solver rebuilt
+    /// from it (after a resume) assembles the matrix the run was using.
+    std::vector<Real> mobility_scale;
+    Real flow_time_step = -1;  ///< the step the flow matrix was factorised for (none yet: -1), s
     std::vector<char> well_shaped;  ///< per tet: dihedral angles of at least 2 degrees at rest
     bool distorted = false;  ///< the last call left a distorted element: remesh before the next
 };
@@ -92,8 +97,6 @@ public:
     struct Entry {
         std::int64_t mesh_version = -1;
         std::optional<BiotSolver> solver;
-        std::vector<Real>
-            assembled_scale;  ///< per tet: the k/k0 the flow matrix was assembled with
     };
     BiotCache() = default;
     BiotCache(const BiotCache&) {}

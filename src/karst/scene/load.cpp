@@ -19,6 +19,15 @@ namespace {
 
 using json = nlohmann::json;
 
+/// FNV-1a of the validated document (defaults filled in, keys sorted) without /time/end, which a
+/// resumed run may extend.
+std::uint64_t scene_fingerprint(json doc) {
+    doc["time"].erase("end");
+    std::uint64_t hash = 14695981039346656037ull;
+    for (const unsigned char c : doc.dump()) hash = (hash ^ c) * 1099511628211ull;
+    return hash;
+}
+
 /// Scenes are hand-written or generated descriptions, never data: 64 MB is far beyond any.
 constexpr std::uintmax_t k_max_scene_bytes = std::uintmax_t(64) << 20;
 
@@ -226,6 +235,7 @@ Scene parse_scene(const std::string& text) {
     s.output.walls = doc["output"]["walls"], s.output.cracks = doc["output"]["cracks"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];
+    s.fingerprint = scene_fingerprint(doc);
     return s;
 }
 

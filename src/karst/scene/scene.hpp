@@ -173,6 +173,9 @@ struct Scene {
     OutputSettings output;
     Real max_speed{};  ///< watchdog, m/s
     int sort_interval{};
+    /// Hash of the validated scene without /time/end: a checkpoint resumes only the scene it
+    /// was written for (sim/checkpoint.hpp).
+    std::uint64_t fingerprint{};
 };
 
 /// Parses and validates scene text; throws SceneError (path, expected, found) on any problem.

@@ -25,6 +25,7 @@ std::pair<Real, Real> fluid_speed_p99_and_max(const FluidParticles& fluid);
 /// over its lowest value so far is energy the numerics made.
 class EnergyAccount {
 public:
+    EnergyAccount() = default;
     explicit EnergyAccount(const Energy& start) : m_start(start), m_lowest(start.total()) {}
     void add(const Energy& e);
     Real released() const { return m_released; }
@@ -36,9 +37,16 @@ public:
     bool gained_more_than(Real fraction) const { return m_worst_ratio > fraction; }
     Real worst_ratio() const { return m_worst_ratio; }
 
+    /// The account's fields for a checkpoint (io/binary_archive.hpp).
+    template <class Archive>
+    friend void fields(Archive& ar, EnergyAccount& a) {
+        ar(a.m_start.kinetic, a.m_start.potential, a.m_lowest, a.m_released, a.m_largest_gain,
+           a.m_largest_rise, a.m_worst_ratio);
+    }
+
 private:
     Energy m_start;
-    Real m_lowest, m_released = 0, m_largest_gain = 0, m_largest_rise = 0, m_worst_ratio = 0;
+    Real m_lowest = 0, m_released = 0, m_largest_gain = 0, m_largest_rise = 0, m_worst_ratio = 0;
 };
 
 }  // namespace karst

@@ -9,6 +9,7 @@
 #include "karst/porous/porous_points.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/scene/schema.hpp"
+#include "karst/sim/checkpoint.hpp"
 #include "karst/sim/energy.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/progress.hpp"
@@ -21,18 +22,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace karst {
-
-namespace {
-
-/// The conserved totals (docs/method.md §4.7-4.8): water is the fluid's mass less its solute and
-/// the water it already gave (drained), plus the pore water; grains are the solute plus the porous
-/// particles' solid mass.
-struct MassTotals {
-    Real water = 0, solute = 0, absorbed = 0, grains = 0;
-};
 
 MassTotals mass_totals(const State& s) {
     const FluidParticles& f = s.fluid;
@@ -46,6 +40,8 @@ MassTotals mass_totals(const State& s) {
         t.solute + deterministic_sum(p.size(), Real(0), [&](Index i) { return p.solid_mass[i]; });
     return t;
 }
+
+namespace {
 
 Index live_fragments(const State& s) {
     Index n = 0;
@@ -102,6 +98,81 @@ Real checked_flag(const char* flag, const std::string& pointer, double value) {
     throw std::logic_error("no schema key " + pointer);
 }
 
+/// What stats.json holds (its wall time aside).
+nlohmann::json run_stats(const Model& model, const State& state, const RunRecord& record,
+                         int frames) {
+    const double step_seconds = record.profile.total();
+    const MassTotals final_totals = mass_totals(state);
+    nlohmann::json phases;
+    for (size_t s = 0; s < size_t(Stage::Count); ++s)
+        phases[std::string(k_stage_names[s])] = record.profile.seconds[s];
+    const PfemTimings& pfem = state.structures.timings;
+    const MeshQuality quality = structure_mesh_quality(state);
+    phases["meshing"] = pfem.meshing, phases["assembly"] = pfem.assembly;
+    phases["factorisation"] = pfem.factorisation, phases["iterations"] = pfem.iterations;
+    return nlohmann::json{
+        {"scene", model.scene.name},
+        {"counts",
+         {{"fluid", state.fluid.size()},
+          {"boundary", model.walls.size()},
+          {"porous", state.porous.size()},
+          {"elements", quality.elements},
+          {"fragments", live_fragments(state)},
+          {"removed", state.removed},
+          {"pushed_back", state.pushed_back},
+          {"porous_removed", state.porous.removed},
+          {"dissolved", state.porous.dissolved},
+          {"fluid_drained", state.porous.fluid_deleted}}},
+        {"steps", state.steps},
+        {"frames", frames},
+        {"sim_time", state.time},
+        {"phases", phases},
+        {"mass",
+         {{"water_initial", record.initial.water},
+          {"water_final", final_totals.water},
+          {"absorbed", state.porous.absorbed},
+          {"absorbed_initial", record.initial.absorbed},
+          {"absorbed_final", final_totals.absorbed},
+          {"solute_initial", record.initial.solute},
+          {"solute_final", final_totals.solute},
+          {"grains_initial", record.initial.grains},
+          {"grains_final", final_totals.grains}}},
+        {"mass_meaning",
+         {{"unit", "kg"},
+          {"water",
+           "all water: in the fluid particles (their mass less any grains) plus in "
+           "the pores; conserved up to fluid that left the domain"},
+          {"absorbed",
+           "net water the pores took from the fluid by pore flow over the run; "
+           "absorbed_final - absorbed_initial differs from it by the remnants "
+           "of drained fluid particles given to the pores and the pore water "
+           "of porous particles that dissolved or left the domain"},
+          {"absorbed_initial", "water in the pores at the start (initial saturation)"},
+          {"absorbed_final", "water in the pores at the end"},
+          {"solute", "dissolved grains carried by the fluid"},
+          {"grains",
+           "all grains: solid mass of the porous particles plus the solute; "
+           "conserved"}}},
+        {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
+        {"biot", biot_stats(pfem)},
+        {"fracture", fracture_stats(state.structures.fracture)},
+        {"mesh",
+         {{"kept", quality.kept},
+          {"polyhedra", quality.polyhedra},
+          {"slivers_dropped", quality.slivers_dropped},
+          {"interior_slivers", quality.interior_slivers}}},
+        {"max_density_error", record.max_density_error},
+        {"frames_over_density_tolerance", record.frames_over_tolerance},
+        {"energy",
+         {{"released", record.energy.released()},
+          {"largest_gain", record.energy.largest_gain()},
+          {"largest_rise_over_start", record.energy.largest_rise_over_start()}}},
+        {"mipps", step_seconds > 0 ? record.particle_steps / step_seconds / 1e6 : 0.0},
+        {"threads", ThreadLimit::active_threads()},
+        {"version", KARST_VERSION},
+    };
+}
+
 }  // namespace
 
 RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
@@ -111,46 +182,72 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     if (!(opt.threads >= 0 && opt.threads <= k_max_threads))
         throw SceneError("--threads", fmt::format("a thread count in [0, {}]", k_max_threads),
                          fmt::format("{}", opt.threads));
+    if (opt.checkpoint_every &&
+        !(*opt.checkpoint_every > 0 && *opt.checkpoint_every <= k_max_checkpoint_interval))
+        throw SceneError("--checkpoint-every",
+                         fmt::format("a simulated time in (0, {:g}] s", k_max_checkpoint_interval),
+                         fmt::format("{}", *opt.checkpoint_every));
+    if (!(opt.checkpoint_keep >= 1 && opt.checkpoint_keep <= k_max_checkpoints_kept))
+        throw SceneError("--checkpoint-keep",
+                         fmt::format("a count in [1, {}]", k_max_checkpoints_kept),
+                         fmt::format("{}", opt.checkpoint_keep));
+    if (opt.resume && opt.out_dir)
+        throw SceneError("--out", "no --out with --resume (a resumed run writes into its folder)",
+                         opt.out_dir->string());
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
-    State state = make_initial_state(model);
+    const CheckpointKey key{scene.fingerprint, scene.output.fps};
+    State state;
+    RunRecord record;
+    RunResult result;
+    std::optional<FrameWriter> out;
+    if (opt.resume) {
+        // Everything is read and checked before the folder is touched.
+        const std::vector<std::string> names = checkpoint_names(*opt.resume);
+        if (names.empty())
+            throw SceneError("--resume", "a folder holding a checkpoint_*.kcp file",
+                             fmt::format("none in '{}'", opt.resume->string()));
+        read_checkpoint(*opt.resume / names.back(), key, state, record);
+        result.out_dir = *opt.resume;
+        out.emplace(result.out_dir, scene.output, record.frames);
+    } else {
+        state = make_initial_state(model);
+        result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
+        out.emplace(result.out_dir, scene.output, opt.overwrite);
+        out->write_boundary(model.walls);
+        // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the
+        // energy released so far is energy the numerics made; the run says so once.
+        record.energy = EnergyAccount(mechanical_energy(model, state));
+    }
     const bool porous = state.porous.size() > 0;
     const bool meshes = !state.structures.empty();
     const bool fluid_frames = !model.poroelastic_only();
 
-    RunResult result;
-    result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
-    FrameWriter out(result.out_dir, scene.output, opt.overwrite);
-    out.write_boundary(model.walls);
-    // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the energy
-    // released so far is energy the numerics made; the run says so once.
-    EnergyAccount energy(mechanical_energy(model, state));
     ProgressLine progress(opt.quiet);
-    bool energy_warned = false, removed_warned = false, biot_warned = false;
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
         log.kinetic_energy = e.kinetic, log.potential_energy = e.potential,
         log.removed = state.removed;
         std::tie(log.speed_p99, log.max_speed) = fluid_speed_p99_and_max(state.fluid);
-        energy.add(e);
-        if (!energy_warned && energy.gained_more_than(0.05)) {
-            energy_warned = true;
+        record.energy.add(e);
+        if (!record.energy_warned && record.energy.gained_more_than(0.05)) {
+            record.energy_warned = true;
             progress.warn(fmt::format(
                 "t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the "
-                "{:.3g} J "
-                "released so far (log.csv has the account)",
-                state.time, energy.largest_gain(), 100 * energy.worst_ratio(), energy.released()));
+                "{:.3g} J released so far (log.csv has the account)",
+                state.time, record.energy.largest_gain(), 100 * record.energy.worst_ratio(),
+                record.energy.released()));
         }
-        if (!removed_warned && state.removed > 0) {
-            removed_warned = true;
+        if (!record.removed_warned && state.removed > 0) {
+            record.removed_warned = true;
             progress.warn(fmt::format(
                 "t = {:.4g} s: fluid left the domain: {} particles ({:.3g} kg) so far; stats.json "
                 "counts.removed has the total",
                 state.time, state.removed, state.removed * model.particle_mass));
         }
-        if (!biot_warned && state.structures.timings.unconverged_calls > 0) {
-            biot_warned = true;
+        if (!record.biot_warned && state.structures.timings.unconverged_calls > 0) {
+            record.biot_warned = true;
             progress.warn(fmt::format(
                 "t = {:.4g} s: a Biot call stopped at /poroelastic/max_iterations = {} above its "
                 "tolerance; stats.json biot.unconverged_calls counts them",
@@ -161,111 +258,58 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         MeshFrame mesh;
         if (meshes) append_structure_meshes(model, state, mesh);
         const CrackFrame cracks = crack_frame(state.structures.cracks);
-        out.write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr,
-                         porous ? &porous_points : nullptr, &cracks},
-                        log);
+        out->write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr,
+                          porous ? &porous_points : nullptr, &cracks},
+                         log);
     };
+    // The checkpoint of the state now, and only the newest --checkpoint-keep of them kept.
+    auto write_checkpoint = [&] {
+        RunRecord now = record;
+        now.frames = out->history();
+        now.wall_seconds += wall.seconds();
+        out->folder().write(checkpoint_name(state.steps), checkpoint_bytes(key, state, now));
+        std::vector<std::string> names = checkpoint_names(out->dir());
+        if (names.size() <= size_t(opt.checkpoint_keep)) return;
+        names.resize(names.size() - opt.checkpoint_keep);
+        out->folder().remove_if([&](const std::string& name) {
+            return std::find(names.begin(), names.end(), name) != names.end();
+        });
+    };
+    const Real every = opt.checkpoint_every.value_or(0);
+    Real next_checkpoint = every > 0 ? every * (std::floor(state.time / every + 1e-9) + 1) : 0;
 
-    // Densities of the initial state, so frame 0 shows them.
-    update_fluid_neighbours(model, state);
-    if (porous) {
-        update_porous_neighbours(model, state);
-        update_porous_boundary_volumes(model, state);
+    if (!opt.resume) {
+        // Densities of the initial state, so frame 0 shows them.
+        update_fluid_neighbours(model, state);
+        if (porous) {
+            update_porous_neighbours(model, state);
+            update_porous_boundary_volumes(model, state);
+        }
+        update_density(model, state);
+        write_frame({0, 0, 0, state.fluid.size(), 0, 0});
+        record.initial = mass_totals(state);
     }
-    update_density(model, state);
-    write_frame({0, 0, 0, state.fluid.size(), 0, 0});
 
-    const MassTotals initial = mass_totals(state);
-    StepProfile profile;
-    Real max_density_error = 0, frame_density_error = 0;
     // The pressure solve's tolerance: frames whose steps ended above it are counted and told.
     const Real density_tolerance = scene.fluid.max_density_error;
-    Index frames_over_tolerance = 0;
-    double particle_steps = 0, frame_particle_steps = 0, frame_step_seconds = 0;
     Stopwatch stepping;
+    const Index steps_before = state.steps;
+    const Real time_before = state.time;
+    double leg_particle_steps = 0;
     FluidParticles last_good;
     PorousState last_good_porous;
     const Real end = scene.time.end;
     const Real frame_dt = 1 / scene.output.fps;
-    int next_frame = 1;
 
     auto stats = [&] {
-        const double step_seconds = profile.total();
-        const MassTotals final_totals = mass_totals(state);
-        nlohmann::json phases;
-        for (size_t s = 0; s < size_t(Stage::Count); ++s)
-            phases[std::string(k_stage_names[s])] = profile.seconds[s];
-        const PfemTimings& pfem = state.structures.timings;
-        const MeshQuality quality = structure_mesh_quality(state);
-        phases["meshing"] = pfem.meshing, phases["assembly"] = pfem.assembly;
-        phases["factorisation"] = pfem.factorisation, phases["iterations"] = pfem.iterations;
-        return nlohmann::json{
-            {"scene", scene.name},
-            {"counts",
-             {{"fluid", state.fluid.size()},
-              {"boundary", model.walls.size()},
-              {"porous", state.porous.size()},
-              {"elements", quality.elements},
-              {"fragments", live_fragments(state)},
-              {"removed", state.removed},
-              {"pushed_back", state.pushed_back},
-              {"porous_removed", state.porous.removed},
-              {"dissolved", state.porous.dissolved},
-              {"fluid_drained", state.porous.fluid_deleted}}},
-            {"steps", state.steps},
-            {"frames", out.frames()},
-            {"sim_time", state.time},
-            {"wall_time", wall.seconds()},
-            {"phases", phases},
-            {"mass",
-             {{"water_initial", initial.water},
-              {"water_final", final_totals.water},
-              {"absorbed", state.porous.absorbed},
-              {"absorbed_initial", initial.absorbed},
-              {"absorbed_final", final_totals.absorbed},
-              {"solute_initial", initial.solute},
-              {"solute_final", final_totals.solute},
-              {"grains_initial", initial.grains},
-              {"grains_final", final_totals.grains}}},
-            {"mass_meaning",
-             {{"unit", "kg"},
-              {"water",
-               "all water: in the fluid particles (their mass less any grains) plus in "
-               "the pores; conserved up to fluid that left the domain"},
-              {"absorbed",
-               "net water the pores took from the fluid by pore flow over the run; "
-               "absorbed_final - absorbed_initial differs from it by the remnants "
-               "of drained fluid particles given to the pores and the pore water "
-               "of porous particles that dissolved or left the domain"},
-              {"absorbed_initial", "water in the pores at the start (initial saturation)"},
-              {"absorbed_final", "water in the pores at the end"},
-              {"solute", "dissolved grains carried by the fluid"},
-              {"grains",
-               "all grains: solid mass of the porous particles plus the solute; "
-               "conserved"}}},
-            {"pore_flow", {{"substeps", state.porous.pore_substeps}}},
-            {"biot", biot_stats(pfem)},
-            {"fracture", fracture_stats(state.structures.fracture)},
-            {"mesh",
-             {{"kept", quality.kept},
-              {"polyhedra", quality.polyhedra},
-              {"slivers_dropped", quality.slivers_dropped},
-              {"interior_slivers", quality.interior_slivers}}},
-            {"max_density_error", max_density_error},
-            {"frames_over_density_tolerance", frames_over_tolerance},
-            {"energy",
-             {{"released", energy.released()},
-              {"largest_gain", energy.largest_gain()},
-              {"largest_rise_over_start", energy.largest_rise_over_start()}}},
-            {"mipps", step_seconds > 0 ? particle_steps / step_seconds / 1e6 : 0.0},
-            {"threads", ThreadLimit::active_threads()},
-            {"version", KARST_VERSION},
-        };
+        nlohmann::json s = run_stats(model, state, record, out->frames());
+        s["wall_time"] = record.wall_seconds + wall.seconds();
+        return s;
     };
 
     try {
         while (state.time < end - 1e-12 * std::max(Real(1), end)) {
-            const Real frame_time = std::min(end, next_frame * frame_dt);
+            const Real frame_time = std::min(end, record.next_frame * frame_dt);
             const Real dt = next_step_length(model, state, frame_time);
             last_good = state.fluid;
             if (porous) last_good_porous = state.porous;
@@ -273,41 +317,49 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             StepReport report;
             try {
                 Stopwatch step_watch;
-                report = step(model, state, dt, profile);
-                frame_step_seconds += step_watch.seconds();
+                report = step(model, state, dt, record.profile);
+                record.frame_step_seconds += step_watch.seconds();
             } catch (const WatchdogError&) {
                 // Keep what was good: the state before the failing step becomes the last frame.
                 state.fluid = last_good;
                 if (porous) state.porous = last_good_porous;
                 state.time = last_good_time;
-                write_frame(
-                    {state.time, dt, state.steps, state.fluid.size(), frame_density_error, 0});
+                write_frame({state.time, dt, state.steps, state.fluid.size(),
+                             record.frame_density_error, 0});
                 throw;
             }
-            max_density_error = std::max(max_density_error, report.max_density_error);
-            frame_density_error = std::max(frame_density_error, report.max_density_error);
+            record.max_density_error = std::max(record.max_density_error, report.max_density_error);
+            record.frame_density_error =
+                std::max(record.frame_density_error, report.max_density_error);
             const double particles = double(state.fluid.size() + state.porous.size());
-            particle_steps += particles;
-            frame_particle_steps += particles;
+            record.particle_steps += particles;
+            leg_particle_steps += particles;
+            record.frame_particle_steps += particles;
 
             const bool frame_due = state.time >= frame_time - 1e-9 * dt;
             if (frame_due) {
-                frames_over_tolerance += frame_density_error > density_tolerance;
-                write_frame(
-                    {state.time, report.dt, state.steps, state.fluid.size(), frame_density_error,
-                     frame_step_seconds > 0 ? frame_particle_steps / frame_step_seconds / 1e6 : 0});
-                ++next_frame;
-                frame_density_error = 0, frame_particle_steps = 0, frame_step_seconds = 0;
+                record.frames_over_tolerance += record.frame_density_error > density_tolerance;
+                write_frame({state.time, report.dt, state.steps, state.fluid.size(),
+                             record.frame_density_error,
+                             record.frame_step_seconds > 0
+                                 ? record.frame_particle_steps / record.frame_step_seconds / 1e6
+                                 : 0});
+                ++record.next_frame;
+                record.frame_density_error = 0, record.frame_particle_steps = 0,
+                record.frame_step_seconds = 0;
             }
-            const double elapsed = stepping.seconds();
-            const double rate = state.time / std::max(elapsed, 1e-9);
-            progress.update({out.frames() - 1, state.time, end,
-                             state.steps / std::max(elapsed, 1e-9),
-                             particle_steps / std::max(elapsed, 1e-9) / 1e6,
-                             (end - state.time) / std::max(rate, 1e-12),
-                             fluid_frames ? state.fluid.size() : state.porous.size(),
-                             porous ? state.porous.absorbed : -1.0, state.removed,
-                             porous ? live_fragments(state) : 0});
+            if (every > 0 && state.time >= next_checkpoint - 1e-9 * dt) {
+                write_checkpoint();
+                next_checkpoint = every * (std::floor(state.time / every + 1e-9) + 1);
+            }
+            const double elapsed = std::max(stepping.seconds(), 1e-9);
+            const double rate = (state.time - time_before) / elapsed;
+            progress.update(
+                {out->frames() - 1, state.time, end, (state.steps - steps_before) / elapsed,
+                 leg_particle_steps / elapsed / 1e6, (end - state.time) / std::max(rate, 1e-12),
+                 fluid_frames ? state.fluid.size() : state.porous.size(),
+                 porous ? state.porous.absorbed : -1.0, state.removed,
+                 porous ? live_fragments(state) : 0});
             if (stop_signal()) break;  // after a whole step: the folder stays consistent
         }
     } catch (const WatchdogError& e) {
@@ -316,22 +368,25 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         result.failure = e.what();
         result.stats = stats();
         result.stats["failure"] = e.what();
-        out.write_stats(result.stats);
+        out->write_stats(result.stats);
         return result;
     }
-    if (frames_over_tolerance > 0)
+    if (record.frames_over_tolerance > 0)
         progress.warn(fmt::format(
             "the density error exceeded /fluid/max_density_error = {:g} in {} of {} frames "
             "(largest {:.3g}): the pressure solve stopped at max_iterations or the step was "
             "too long; raise /fluid/max_iterations or lower /time/cfl",
-            density_tolerance, frames_over_tolerance, out.frames() - 1, max_density_error));
+            density_tolerance, record.frames_over_tolerance, out->frames() - 1,
+            record.max_density_error));
     progress.finish();
+    // At the end, or where a signal stopped the run: a later --resume continues from here.
+    if (every > 0) write_checkpoint();
     result.stats = stats();
     if (stop_signal()) {
         result.stop_signal = stop_signal();
         result.stats["interrupted"] = {{"signal", result.stop_signal}, {"time", state.time}};
     }
-    out.write_stats(result.stats);
+    out->write_stats(result.stats);
     return result;
 }
 

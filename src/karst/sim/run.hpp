@@ -12,6 +12,9 @@ namespace karst {
 
 /// Most worker threads --threads accepts (TBB uses at most the machine's cores anyway).
 inline constexpr int k_max_threads = 1024;
+/// Longest --checkpoint-every (simulated s) and most --checkpoint-keep.
+inline constexpr double k_max_checkpoint_interval = 1e6;
+inline constexpr int k_max_checkpoints_kept = 1000;
 
 struct RunOptions {
     std::optional<std::filesystem::path> out_dir;  ///< default out/<scene name>/
@@ -20,6 +23,12 @@ struct RunOptions {
     int threads = 0;                               ///< 0: all cores
     bool quiet = false;
     bool overwrite = false;  ///< write into a non-empty folder no karst run wrote
+    /// Simulated seconds between checkpoints (sim/checkpoint.hpp); one is also written at the
+    /// end and when a signal stops the run. None when not given.
+    std::optional<double> checkpoint_every;
+    int checkpoint_keep = 2;  ///< newest checkpoints kept in the folder
+    /// Continue the run in this folder from its newest checkpoint (frames and stats go there).
+    std::optional<std::filesystem::path> resume;
 };
 
 struct RunResult {
@@ -30,8 +39,9 @@ struct RunResult {
     nlohmann::json stats;  ///< what stats.json holds
 };
 
-/// Runs `scene` to its end time, writing frames. Throws SceneError before writing anything if
-/// the scene or the options are bad; a watchdog stop returns ok = false after writing the last
+/// Runs `scene` to its end time, writing frames (or continues it from a checkpoint, bit for bit
+/// as if it had never stopped). Throws SceneError before writing anything if the scene, the
+/// options or the checkpoint are bad; a watchdog stop returns ok = false after writing the last
 /// good frame and stats.json.
 RunResult run_simulation(const Scene& scene, const RunOptions& options);
 
