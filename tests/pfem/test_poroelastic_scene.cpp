@@ -127,6 +127,9 @@ TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
               "/porous_solids/0/material/biot_coefficient");
     EXPECT_EQ(refuse(edit("\"axes\": \"x\"", "\"axes\": \"w\"")).path,
               "/porous_solids/0/constraints/0/axes");
+    // A platen moves along one axis; the default "xyz" is three.
+    EXPECT_EQ(refuse(edit("\"kind\": \"drained\"", "\"kind\": \"platen\"")).path,
+              "/porous_solids/0/constraints/5/axes");
     EXPECT_EQ(refuse(edit("\"youngs_modulus\": 7.2", "\"youngs_modulus\": -7.2")).path,
               "/porous_solids/0/material/youngs_modulus");
     // Time tables: rows of two numbers, times from 0 on and increasing.
@@ -212,6 +215,78 @@ TEST(PoroelasticScene, APlatenMovedByATimeTableStrainsTheBarUniformly) {
             ASSERT_NEAR(stress.effective[a](1, 1), 0, 1e-5 * 1e6 * delta / L);
         }
     }
+}
+
+/// A 0.4 x 0.4 m block of E = 1 MPa, nu = 0.25, drained throughout (so each call is its
+/// drained state), spacing 0.1, with `constraints` (JSON) and a load `top` on its top layer.
+std::string loaded_block(Real height, const std::string& constraints, const std::string& top) {
+    return fmt::format(R"({{
+      "name": "platen", "particle_spacing": 0.1, "gravity": [0, 0, 0], "poroelastic": {{ "time_step": 1 }},
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, {}] }},
+        "material": {{ "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "poisson_ratio": 0.25,
+                      "tensile_strength": 1e9 }},
+        "constraints": [
+          {{ "kind": "drained", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] }} }},
+          {}, {{ "region": {{ "type": "box", "min": [-1, -1, {}], "max": [2, 2, 2] }}, {} }} ] }} ]
+    }})",
+                       height, constraints, height, top);
+}
+
+/// The top layer's nodes (z above `height` - dx) and their vertical displacements.
+std::vector<Real> top_settlement(const test::Simulation& sim, Real height) {
+    const Structure& s = sim.state.structures.structures.at(0);
+    std::vector<Real> uz;
+    for (Index a = 0; a < s.mesh.node_count(); ++a)
+        if (s.mesh.nodes[a].z() > height - 0.1) uz.push_back(s.fields.u[a].z());
+    return uz;
+}
+
+TEST(PoroelasticScene, ARigidPlatenUnderATotalForceSettlesAConfinedColumnLikeItsTraction) {
+    // A 1 m column on rollers (each side held normal to itself, the base vertically) pressed by
+    // F = 900 N: the oedometric strain F / (A M), A = 0.3 x 0.3 m between the outer node layers,
+    // M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) = 1.2 MPa, over the 0.9 m between the end layers.
+    const std::string rollers = R"(
+      { "kind": "fixed", "axes": "x", "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+      { "kind": "fixed", "axes": "x", "region": { "type": "box", "min": [0.4, -1, -1], "max": [2, 2, 2] } },
+      { "kind": "fixed", "axes": "y", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 0, 2] } },
+      { "kind": "fixed", "axes": "y", "region": { "type": "box", "min": [-1, 0.4, -1], "max": [2, 2, 2] } },
+      { "kind": "fixed", "axes": "z", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 0] } })";
+    const Real F = 900, A = 0.09, M = 1.2e6, expected = -F / (A * M) * 0.9;
+    test::Simulation platen(
+        loaded_block(1.0, rollers, R"("kind": "platen", "axes": "z", "force": -900)"));
+    test::Simulation traction(
+        loaded_block(1.0, rollers, R"("kind": "traction", "traction": [0, 0, -10000])"));
+    platen.advance(), traction.advance();
+    const std::vector<Real> by_platen = top_settlement(platen, 1.0);
+    const std::vector<Real> by_traction = top_settlement(traction, 1.0);
+    ASSERT_EQ(by_platen.size(), 16u);
+    for (size_t k = 0; k < by_platen.size(); ++k) {
+        EXPECT_NEAR(by_platen[k], expected, 1e-3 * std::abs(expected)) << "platen node " << k;
+        EXPECT_NEAR(by_platen[k], by_traction[k], 0.01 * std::abs(expected)) << "node " << k;
+        EXPECT_NEAR(by_platen[k], by_platen[0], 1e-12 * std::abs(expected)) << "node " << k;
+    }
+}
+
+TEST(PoroelasticScene, ARigidPlatenMovesItsNodesAsOneWhereATractionWouldTiltThem) {
+    // A block held only under half of its base: the same total load as a traction tilts the top
+    // (2.4 mm over the held half, 4.4 mm over the free one), while the platen's nodes share one
+    // settlement (3.2 mm) to round-off.
+    const std::string half_base = R"(
+      { "kind": "fixed", "region": { "type": "box", "min": [-1, -1, -1], "max": [0.2, 2, 0] } })";
+    test::Simulation platen(
+        loaded_block(0.4, half_base, R"("kind": "platen", "axes": "z", "force": -900)"));
+    test::Simulation traction(
+        loaded_block(0.4, half_base, R"("kind": "traction", "traction": [0, 0, -10000])"));
+    platen.advance(), traction.advance();
+    auto spread = [](const std::vector<Real>& u) {  // (max - min, largest |u|), m
+        const auto [lo, hi] = std::minmax_element(u.begin(), u.end());
+        return std::pair{*hi - *lo, std::max(std::abs(*lo), std::abs(*hi))};
+    };
+    const auto [platen_spread, platen_largest] = spread(top_settlement(platen, 0.4));
+    const auto [traction_spread, traction_largest] = spread(top_settlement(traction, 0.4));
+    ASSERT_GT(platen_largest, 0);
+    EXPECT_LT(platen_spread, 1e-12 * platen_largest) << "m";
+    EXPECT_GT(traction_spread, 0.2 * traction_largest) << "m";
 }
 
 }  // namespace

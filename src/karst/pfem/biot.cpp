@@ -44,14 +44,44 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
     // A mesh whose every node is fixed (a thin layer between walls) has no elastic system:
     // u stays prescribed and only the flow is solved.
     // A free body's six near-rigid modes (eps diag K) defeat CG: it stays direct.
-    elastic_iterative = options.linear_solver == LinearSolver::Amg && !problem.free_body;
+    // Platens tie rows across nodes, which the per-node systems AMG does not expect: direct.
+    elastic_iterative =
+        options.linear_solver == LinearSolver::Amg && !problem.free_body && problem.platens.empty();
+    tie_platens();
     flow_iterative = options.linear_solver == LinearSolver::Amg ||
                      (options.linear_solver == LinearSolver::Auto &&
                       p_dofs.free_count >= options.amg_flow_unknowns);
     if (u_dofs.free_count > 0)
-        elastic.compute(K_ff, elastic_iterative,
-                        elastic_iterative ? elastic_amg_options() : AmgOptions{});
+        elastic.compute(tie.cols() > 0 ? SparseMatrix(tie.transpose() * K_ff * tie) : K_ff,
+                        elastic_iterative, elastic_iterative ? elastic_amg_options() : AmgOptions{});
     t_elastic_factor = factor_watch.seconds();
+}
+
+void BiotSolver::Impl::tie_platens() {
+    if (problem.platens.empty()) return;
+    std::vector<int> unknown(size_t(u_dofs.free_count), -1);
+    int count = 0;
+    for (const BiotProblem::Platen& platen : problem.platens) {
+        int shared = -1;
+        for (Index a : platen.nodes) {
+            const int row = u_dofs.free_index[3 * a + platen.axis];
+            if (row < 0 || unknown[row] >= 0) continue;  // held, or in an earlier platen
+            if (shared < 0) shared = count++;
+            unknown[row] = shared;
+        }
+    }
+    Triplets entries;
+    for (int row = 0; row < u_dofs.free_count; ++row) {
+        if (unknown[row] < 0) unknown[row] = count++;
+        entries.emplace_back(row, unknown[row], 1.0);
+    }
+    tie.resize(u_dofs.free_count, count);
+    tie.setFromTriplets(entries.begin(), entries.end());
+}
+
+Vector BiotSolver::Impl::solve_elastic(const Vector& rhs, const Vector& guess) {
+    if (tie.cols() == 0) return elastic.solve(rhs, guess);
+    return tie * elastic.solve(tie.transpose() * rhs, Vector::Zero(tie.cols()));  // direct
 }
 
 AmgOptions BiotSolver::Impl::elastic_amg_options() const {
@@ -115,7 +145,7 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
     const bool as_last_solve = last_elastic_rhs.size() == rhs_predictor.size() &&
                                rhs_predictor == last_elastic_rhs && u == last_elastic_u;
     if (!as_last_solve && u_dofs.free_count > 0)
-        u_dofs.scatter_free(elastic.solve(rhs_predictor, u_dofs.gather_free(u)), u),
+        u_dofs.scatter_free(solve_elastic(rhs_predictor, u_dofs.gather_free(u)), u),
             ++report.elastic_solves;
     // Anderson mixing of the pressure iterates [D] (beyond M22): fewer fixed-stress iterations
     // per call, most where tau is large. The fixed-strain order is left plain: it is kept to
@@ -140,7 +170,7 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
         balance.apply(rhs_u);
         Vector u_next = u;
         if (u_dofs.free_count > 0)
-            u_dofs.scatter_free(elastic.solve(rhs_u, u_dofs.gather_free(u)), u_next);
+            u_dofs.scatter_free(solve_elastic(rhs_u, u_dofs.gather_free(u)), u_next);
         last_elastic_rhs = rhs_u, last_elastic_u = u_next;
         ++report.elastic_solves;
         // 3. Changes relative to the change over the call [D]: M22 divides by |p^{k+1}|, but

@@ -48,6 +48,13 @@ struct BiotProblem {
     std::vector<Real> drained_pressure;  ///< optional, Pa
     std::vector<Vec3> nodal_force;       ///< optional external loads (tractions, fluid), N
     Vec3 gravity = Vec3::Zero();         ///< m/s^2
+    /// Rigid frictionless platens: the nodes of each share one displacement component `axis`
+    /// (their loads along it add up on that one unknown). Nodes held on the axis are not members.
+    struct Platen {
+        std::vector<Index> nodes;
+        int axis = 2;
+    };
+    std::vector<Platen> platens;
     /// A fragment without anchors: add eps diag(K) to remove the six rigid modes (§5.3).
     bool free_body = false;
     /// The nodes of each piece (tets joined by faces) that some rigid motion leaves untouched by

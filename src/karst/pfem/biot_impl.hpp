@@ -31,6 +31,9 @@ struct BiotSolver::Impl {
     DofSplit u_dofs{{}}, p_dofs{{}};
     SparseMatrix K_ff, K_fc, H_ff, H_fc;
     Vector elastic_lift;                      // K_fc u_c
+    // Rigid platens: free displacement rows = tie * (unknowns with each platen's members as one);
+    // the elasticity solved is tie^T K_ff tie. Empty (0 columns) without platens.
+    SparseMatrix tie;
     Vector last_elastic_rhs, last_elastic_u;  // the last mechanics solve: its right side and full u
     SpdSolve elastic, flow;                   // LinearSolver in biot.hpp says which each gets
     bool elastic_iterative = false, flow_iterative = false;
@@ -65,6 +68,10 @@ struct BiotSolver::Impl {
                                const std::vector<Real>& drained_pressure);
     /// (S + L M + dt H)_ff, factorised when dt or the mobility changed.
     void factorise_flow(Real dt, Real L);
+    /// tie from the problem's platens.
+    void tie_platens();
+    /// K_ff u = rhs on the free rows (through the platen tie when there is one).
+    Vector solve_elastic(const Vector& rhs, const Vector& guess);
     /// One call: the fixed-stress (or fixed-strain) iteration of M22.
     BiotCallReport advance(Real dt, BiotFields& fields);
 };

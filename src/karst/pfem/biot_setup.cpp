@@ -81,6 +81,19 @@ bool touches_wall(const Model& model, const Vec3& x) {
     return false;
 }
 
+/// The nodes a platen constraint moves: on its region and not held by a wall.
+std::vector<Index> platen_nodes(const Model& model, const Constraint& c, const TetMesh& mesh) {
+    std::vector<Index> nodes;
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        if (on_region(model, c, mesh.nodes[a]) && !touches_wall(model, mesh.nodes[a]))
+            nodes.push_back(a);
+    return nodes;
+}
+
+int platen_axis(const Constraint& c) {
+    return c.axes == 1 ? 0 : c.axes == 2 ? 1 : 2;
+}
+
 }  // namespace
 
 BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
@@ -94,6 +107,13 @@ BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, con
         if (c.kind == Constraint::Kind::Traction) {
             const auto loads = traction_loads(mesh, factor * c.traction, inside);
             for (Index a = 0; a < n; ++a) b.nodal_force[a] += loads[a];
+            continue;
+        }
+        if (c.kind == Constraint::Kind::Platen) {
+            // The total force, spread evenly: the tied unknown takes their sum.
+            const std::vector<Index> nodes = platen_nodes(model, c, mesh);
+            for (Index a : nodes)
+                b.nodal_force[a][platen_axis(c)] += factor * c.force / Real(nodes.size());
             continue;
         }
         for (Index a = 0; a < n; ++a) {
@@ -146,7 +166,8 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     p.fixed.assign(n, 0), p.drained.assign(n, 0);
     for (const Constraint& c : solid.constraints)
         for (Index a = 0; a < n; ++a) {
-            if (c.kind == Constraint::Kind::Traction || !on_region(model, c, mesh.nodes[a]))
+            if (c.kind == Constraint::Kind::Traction || c.kind == Constraint::Kind::Platen ||
+                !on_region(model, c, mesh.nodes[a]))
                 continue;
             if (c.kind == Constraint::Kind::Fixed)
                 p.fixed[a] |= c.axes;
@@ -155,6 +176,13 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
         }
     for (Index a = 0; a < n; ++a)
         if (touches_wall(model, mesh.nodes[a])) p.fixed[a] = FixAll;
+    for (const Constraint& c : solid.constraints) {
+        if (c.kind != Constraint::Kind::Platen) continue;
+        BiotProblem::Platen platen{{}, platen_axis(c)};
+        for (Index a : platen_nodes(model, c, mesh))
+            if (!(p.fixed[a] & c.axes)) platen.nodes.push_back(a);
+        if (platen.nodes.size() > 1) p.platens.push_back(std::move(platen));
+    }
     BoundaryValues values = boundary_values(model, solid, mesh, 0);
     p.nodal_force = std::move(values.nodal_force);
     p.prescribed_u = std::move(values.prescribed_u);

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -189,13 +190,18 @@ Scene parse_scene(const std::string& text) {
             con.kind =
                 option<Constraint::Kind>(cj["kind"], {{"fixed", Constraint::Kind::Fixed},
                                                       {"drained", Constraint::Kind::Drained},
-                                                      {"traction", Constraint::Kind::Traction}});
+                                                      {"traction", Constraint::Kind::Traction},
+                                                      {"platen", Constraint::Kind::Platen}});
             con.region = read_shape(cj["region"], con.path + "/region");
             const std::string axes = cj["axes"];
             con.axes = std::uint8_t((axes.find('x') != std::string::npos ? 1 : 0) |
                                     (axes.find('y') != std::string::npos ? 2 : 0) |
                                     (axes.find('z') != std::string::npos ? 4 : 0));
+            if (con.kind == Constraint::Kind::Platen && std::popcount(con.axes) != 1)
+                throw SceneError(con.path + "/axes", "one axis (x, y or z) for a platen",
+                                 cj["axes"].dump());
             con.pressure = cj["pressure"], con.traction = vec3(cj["traction"]);
+            con.force = cj["force"];
             con.displacement = vec3(cj["displacement"]);
             if (cj.contains("table"))
                 for (const json& row : cj["table"])

@@ -104,13 +104,14 @@ struct TimeTable {
 /// A boundary condition of the Biot problem on a region of a porous solid. Its value (traction,
 /// pressure or displacement) is multiplied by the table's factor at the time of each Biot call.
 struct Constraint {
-    enum class Kind { Fixed, Drained, Traction };
+    enum class Kind { Fixed, Drained, Traction, Platen };
     Kind kind{};
     Shape region;
-    std::uint8_t axes{};               ///< Fixed: bits x = 1, y = 2, z = 4
+    std::uint8_t axes{};               ///< Fixed: bits x = 1, y = 2, z = 4; Platen: one bit
     Vec3 displacement = Vec3::Zero();  ///< Fixed, m
     Real pressure{};                   ///< Drained, Pa
     Vec3 traction = Vec3::Zero();      ///< Traction, Pa
+    Real force{};                      ///< Platen: total force along its axis, N
     TimeTable table;
     std::string path;
 };

@@ -240,23 +240,29 @@ std::vector<KeySpec> make_schema() {
         required("/porous_solids/[]/constraints/[]/kind", T::Enum, "", any(),
                  "fixed: displacement prescribed (0 unless given) on the given axes; drained: pore "
                  "pressure prescribed; "
-                 "traction: a uniform traction on the surface facets inside the region.",
-                 {"fixed", "drained", "traction"}),
+                 "traction: a uniform traction on the surface facets inside the region; "
+                 "platen: a rigid frictionless platen, the nodes in the region share one "
+                 "displacement along `axes` (one axis) and carry the total `force` along it.",
+                 {"fixed", "drained", "traction", "platen"}),
         required("/porous_solids/[]/constraints/[]/region", T::Shape, "", any(),
                  "Where the condition holds."),
         key("/porous_solids/[]/constraints/[]/axes", T::Enum, "", any(), "xyz",
-            "fixed only: the displacement components held at 0.",
+            "fixed: the displacement components held (at 0 unless `displacement` says); platen: "
+            "its one axis.",
             {"xyz", "x", "y", "z", "xy", "xz", "yz"}),
         key("/porous_solids/[]/constraints/[]/pressure", T::Number, "Pa", closed(-1e12, 1e12), 0.0,
             "drained only: the prescribed pore pressure."),
         key("/porous_solids/[]/constraints/[]/traction", T::Vec3, "Pa", closed(-1e12, 1e12), zero3,
             "traction only: force per area on the surface (e.g. [0, 0, -1e4] presses down)."),
+        key("/porous_solids/[]/constraints/[]/force", T::Number, "N", closed(-1e15, 1e15), 0.0,
+            "platen only: the total force on the platen along its axis (negative pushes toward "
+            "-axis), shared by its nodes; with `table`, a load-controlled test."),
         key("/porous_solids/[]/constraints/[]/displacement", T::Vec3, "m", closed(-1e3, 1e3), zero3,
             "fixed only: the prescribed displacement of the held components (a platen that moves "
             "with `table`)."),
         optional("/porous_solids/[]/constraints/[]/table", T::Table, "", closed(-1e6, 1e6),
                  "A piecewise-linear time table [[t0, f0], [t1, f1], ...] (t in s, increasing from "
-                 "0 on) that multiplies the constraint's traction, pressure or displacement: "
+                 "0 on) that multiplies the constraint's traction, pressure, displacement or force: "
                  "constant before the first row and after the last. Absent: a factor of 1. A load "
                  "that ramps to failure, a pressure raised in steps, a platen moved at a rate."),
 
