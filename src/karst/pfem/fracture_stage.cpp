@@ -45,25 +45,6 @@ void append_copy(PorousParticles& p, Index i, Index id) {
     p.id.back() = id;
 }
 
-/// A free rigid fragment of the members `members`: mass properties at rest orientation, and the
-/// linear and angular momentum the members carry, so that neither changes.
-Fragment free_fragment(PorousParticles& p, const std::vector<Index>& members, Real spacing) {
-    std::vector<Vec3> x, body;
-    std::vector<Real> mass;
-    for (Index i : members)
-        x.push_back(p.x[i]), mass.push_back(p.solid_mass[i] + p.absorbed_mass[i]);
-    Fragment f = fragment_at_rest(x, mass, body, spacing);
-    Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
-    for (size_t k = 0; k < members.size(); ++k) {
-        const Vec3& v = p.v[members[k]];
-        momentum += mass[k] * v, angular += mass[k] * body[k].cross(v);
-        p.rest[members[k]] = body[k];
-    }
-    f.velocity = momentum / f.mass, f.angular_momentum = angular;
-    f.anchored = false;
-    return f;
-}
-
 /// The bedding normal at each node, from its tensor K0 (M12): the axis whose permeability is the
 /// odd one out (the smallest when k along the layers exceeds k across, else the largest).
 std::vector<Vec3> layer_normals(const std::vector<Mat3>& tensors, Real ratio) {

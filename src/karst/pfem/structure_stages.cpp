@@ -90,7 +90,7 @@ void build(const Model& model, State& state, size_t slot) {
         s.node_tensors[a] = st.rest_tensor[id], s.fields.u[a] = st.u[id];
     }
     s.u_from = s.fields.u;
-    s.distorted = false;
+    s.distorted = false, s.grown = false;
     const BiotProblem& problem = solver_of(model, state, slot).problem();
     for (Index a = 0; a < n; ++a)
         if (problem.drained[a])
@@ -193,6 +193,8 @@ void remesh_structures(const Model& model, State& state) {
         Index lost = 0;
         for (Index a = 0; a < n; ++a) lost += index_of[s.node_id[a]] < 0;
         if (lost > k_remesh_lost_fraction * n) {
+            for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
+        } else if (s.grown) {
             for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
         } else if (s.distorted) {
             // [D] A distorted mesh is rebuilt on the deformed positions, which become the new

@@ -38,6 +38,7 @@ struct Structure {
     Real flow_time_step = -1;  ///< the step the flow matrix was factorised for (none yet: -1), s
     std::vector<char> well_shaped;  ///< per tet: dihedral angles of at least 2 degrees at rest
     bool distorted = false;  ///< the last call left a distorted element: remesh before the next
+    bool grown = false;      ///< a merged fragment's particles joined: remesh before the next call
 };
 
 /// Seconds spent per PFEM phase and what the calls did, summed over structures and calls
@@ -60,6 +61,7 @@ struct CrackRecord {
 /// What fracture did so far (stats.json "fracture"; its time is the step profile's "fracture").
 struct FractureCounts {
     Index cracks = 0, links_broken = 0, nodes_split = 0, fragments_created = 0;
+    Index merges = 0;  ///< fragments that joined another (§5.6)
 };
 
 struct StructureState {

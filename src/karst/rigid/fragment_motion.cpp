@@ -87,6 +87,23 @@ void advance_fragments(const Model& model, State& state, Real dt) {
     }
 }
 
+Fragment free_fragment(PorousParticles& p, const std::vector<Index>& members, Real spacing) {
+    std::vector<Vec3> x, body;
+    std::vector<Real> mass;
+    for (Index i : members)
+        x.push_back(p.x[i]), mass.push_back(p.solid_mass[i] + p.absorbed_mass[i]);
+    Fragment f = fragment_at_rest(x, mass, body, spacing);
+    Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
+    for (size_t k = 0; k < members.size(); ++k) {
+        const Vec3& v = p.v[members[k]];
+        momentum += mass[k] * v, angular += mass[k] * body[k].cross(v);
+        p.rest[members[k]] = body[k], p.body_permeability[members[k]] = p.permeability[members[k]];
+    }
+    f.velocity = momentum / f.mass, f.angular_momentum = angular;
+    f.anchored = false;
+    return f;
+}
+
 void refresh_fragment_mass(State& state, Real spacing) {
     PorousParticles& p = state.porous.particles;
     std::vector<Fragment>& fragments = state.porous.fragments;

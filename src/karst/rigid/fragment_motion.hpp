@@ -12,6 +12,11 @@ namespace karst {
 /// K = R K0 R^T (M12). Porous particles leaving the domain are removed and counted.
 void advance_fragments(const Model& model, State& state, Real dt);
 
+/// A free rigid fragment of `members` in their current pose (rest orientation: body frame =
+/// world frame): mass properties, and the linear and angular momentum the members carry, so
+/// that neither changes. Writes the members' body-frame positions and tensors.
+Fragment free_fragment(PorousParticles& p, const std::vector<Index>& members, Real spacing);
+
 /// Mass, centre and inertia of every fragment from its members (M = sum m_s + m_p, wet mass
 /// included). The rigid velocity field is kept: v moves to the new centre (v + omega x dc) and
 /// L = I_w omega, so members that leave (dissolution) take exactly their own momentum.

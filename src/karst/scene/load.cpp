@@ -235,6 +235,9 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];
     s.fracture.enabled = doc["fracture"]["enabled"],
     s.fracture.max_cracks_per_call = doc["fracture"]["max_cracks_per_call"];
+    s.fracture.merge = doc["fracture"]["merge"];
+    s.fracture.merge_saturation = doc["fracture"]["merge_saturation"];
+    s.fracture.merge_speed = doc["fracture"]["merge_speed"];
     s.output.fps = doc["output"]["fps"], s.output.vtp = doc["output"]["vtp"],
     s.output.ply = doc["output"]["ply"], s.output.compress = doc["output"]["compress"];
     s.output.porous = doc["output"]["porous"], s.output.mesh = doc["output"]["mesh"];

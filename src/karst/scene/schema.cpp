@@ -260,11 +260,12 @@ std::vector<KeySpec> make_schema() {
         key("/porous_solids/[]/constraints/[]/displacement", T::Vec3, "m", closed(-1e3, 1e3), zero3,
             "fixed only: the prescribed displacement of the held components (a platen that moves "
             "with `table`)."),
-        optional("/porous_solids/[]/constraints/[]/table", T::Table, "", closed(-1e6, 1e6),
-                 "A piecewise-linear time table [[t0, f0], [t1, f1], ...] (t in s, increasing from "
-                 "0 on) that multiplies the constraint's traction, pressure, displacement or force: "
-                 "constant before the first row and after the last. Absent: a factor of 1. A load "
-                 "that ramps to failure, a pressure raised in steps, a platen moved at a rate."),
+        optional(
+            "/porous_solids/[]/constraints/[]/table", T::Table, "", closed(-1e6, 1e6),
+            "A piecewise-linear time table [[t0, f0], [t1, f1], ...] (t in s, increasing from "
+            "0 on) that multiplies the constraint's traction, pressure, displacement or force: "
+            "constant before the first row and after the last. Absent: a factor of 1. A load "
+            "that ramps to failure, a pressure raised in steps, a platen moved at a rate."),
 
         key("/pore_flow", T::Object, "", any(), json::object(),
             "Transport of pore water between porous particles (docs/method.md §4.7)."),
@@ -350,6 +351,15 @@ std::vector<KeySpec> make_schema() {
         key("/fracture/max_cracks_per_call", T::Integer, "", closed(1, 1000), 8,
             "N_crack: most cracks per structure and Biot call, taken in decreasing "
             "sigma'_1 / sigma_t; none within h of another crack of the same call."),
+        key("/fracture/merge", T::Bool, "", any(), true,
+            "Fragments that touch while wet join again (docs/method.md §5.6): the mean saturation "
+            "of their touching particles at least merge_saturation, every touching pair closing "
+            "slower than merge_speed, and at least 3 tets of the weighted alpha shape of the "
+            "contact spanning both. Two sides of one crack never rejoin."),
+        key("/fracture/merge_saturation", T::Number, "", closed(0, 10), 0.9,
+            "S_merge: the contact's mean saturation needed to merge."),
+        key("/fracture/merge_speed", T::Number, "m/s", closed(0, 100), 0.05,
+            "v_merge: the closing speed below which touching fragments may merge."),
         key("/output", T::Object, "", any(), json::object(), "What is written, and how often."),
         key("/output/fps", T::Number, "1/s", closed(0.1, 10000), 30.0,
             "Frames per simulated second."),

@@ -65,7 +65,7 @@ template <class Ar>
 void fields(Ar& ar, Structure& s) {
     ar(s.fragment, s.solid, s.mesh_version, s.node_id, s.mesh, s.links, s.fields, s.u_from,
        s.node_tensors, s.permeability_scale, s.mobility_scale, s.flow_time_step, s.well_shaped,
-       s.distorted);
+       s.distorted, s.grown);
 }
 
 template <class Ar>
@@ -81,7 +81,7 @@ void fields(Ar& ar, CrackRecord& c) {
 
 template <class Ar>
 void fields(Ar& ar, FractureCounts& f) {
-    ar(f.cracks, f.links_broken, f.nodes_split, f.fragments_created);
+    ar(f.cracks, f.links_broken, f.nodes_split, f.fragments_created, f.merges);
 }
 
 template <class Ar>

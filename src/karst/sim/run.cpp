@@ -63,7 +63,8 @@ nlohmann::json fracture_stats(const FractureCounts& f) {
     return {{"cracks", f.cracks},
             {"links_broken", f.links_broken},
             {"nodes_split", f.nodes_split},
-            {"fragments_created", f.fragments_created}};
+            {"fragments_created", f.fragments_created},
+            {"merges", f.merges}};
 }
 
 /// The porous frame: pore state (porous/porous_points.hpp) on neighbour lists of the current

@@ -10,6 +10,7 @@
 #include "karst/coupling/porous_boundary_volumes.hpp"
 #include "karst/coupling/porous_neighbours.hpp"
 #include "karst/pfem/fracture_stage.hpp"
+#include "karst/pfem/merge_stage.hpp"
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/porous/dissolution.hpp"
 #include "karst/porous/drained_fluid.hpp"
@@ -216,6 +217,13 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         //    pore water and the members they lost.
         timed(profile, Stage::Dissolution, [&] {
             dissolve_particles(model, state);
+            refresh_fragment_mass(state, model.dx);
+        });
+        // 12. Wet fragments in slow contact merge (§5.6, Fig. 7); one merged into an anchored
+        //     fragment joins its structure at the next Biot call's remesh.
+        timed(profile, Stage::Fracture, [&] {
+            if (!merge_fragments(model, state)) return;
+            state.porous_scratch.pairs_stale = true;
             refresh_fragment_mass(state, model.dx);
         });
         // 11. Algorithm 2 on the anchored fragments every dt_B (§5): the members move toward the
