@@ -18,8 +18,9 @@ namespace {
 
 constexpr Real k_strength = 1e5, k_dx = 0.1;
 
-CrackSettings settings(Real strength) {
+CrackSettings settings(Real strength, CrackCriterion criterion = CrackCriterion::Rankine) {
     CrackSettings s;
+    s.criterion = criterion;
     s.tensile_strength = strength, s.fracture_energy = 10, s.spacing = k_dx;
     s.exclusion = 2 * k_dx, s.max_cracks = 8;
     return s;
@@ -64,10 +65,10 @@ struct Sample {
         stress = nodal_stress(mesh, problem.material, fields);
     }
 
-    std::vector<Crack> cracks() const {
+    std::vector<Crack> cracks(CrackCriterion criterion = CrackCriterion::Rankine) const {
         std::vector<Index> ids(mesh.node_count());
         for (Index a = 0; a < mesh.node_count(); ++a) ids[a] = a;
-        return find_cracks(mesh, stress, ids, settings(k_strength));
+        return find_cracks(mesh, stress, ids, settings(k_strength, criterion));
     }
 };
 
@@ -118,6 +119,40 @@ TEST(Cracks, HydrostaticCompressionNeverCracks) {
     const Sample s(Vec3(0.6, 0.4, 0.5), Mat3::Identity(), -100 * k_strength * Mat3::Identity());
     EXPECT_LT(s.stress.principal[0][0], -99 * k_strength);
     EXPECT_TRUE(s.cracks().empty());
+}
+
+TEST(Cracks, TheSeparationTensorCracksUniaxialTensionAtTheStrengthAndShearAt45Degrees) {
+    constexpr auto separation = CrackCriterion::SeparationTensor;
+    const Vec3 size(1.2, 0.3, 0.3);
+    for (const Mat3& turn : {Mat3(Mat3::Identity()), turned_30_about_two_axes()}) {
+        EXPECT_TRUE(Sample(size, turn, uniaxial(0.95 * k_strength)).cracks(separation).empty());
+        const std::vector<Crack> cracks =
+            Sample(size, turn, uniaxial(1.05 * k_strength)).cracks(separation);
+        ASSERT_FALSE(cracks.empty());
+        for (const Crack& c : cracks) {
+            EXPECT_LT(angle_deg(c.normal, turn * Vec3::UnitX()), 5);
+            EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
+        }
+    }
+    Mat3 shear = Mat3::Zero();
+    shear(0, 1) = shear(1, 0) = 1.1 * k_strength;
+    const Vec3 plate(0.6, 0.6, 0.3);
+    const std::vector<Crack> cracks = Sample(plate, Mat3::Identity(), shear).cracks(separation);
+    ASSERT_FALSE(cracks.empty());
+    for (const Crack& c : cracks) EXPECT_LT(angle_deg(c.normal, Vec3(1, 1, 0)), 5);
+    EXPECT_TRUE(Sample(plate, Mat3::Identity(), shear * 0.95 / 1.1).cracks(separation).empty());
+    const Sample squeezed(Vec3(0.6, 0.4, 0.5), Mat3::Identity(),
+                          -100 * k_strength * Mat3::Identity());
+    EXPECT_TRUE(squeezed.cracks(separation).empty());
+    // Pore pressure alone, through the effective stress.
+    const Real B = 0.9;
+    const Vec3 block(0.5, 0.4, 0.3);
+    EXPECT_TRUE(Sample(block, Mat3::Identity(), Mat3::Zero(), 0.95 * k_strength / B)
+                    .cracks(separation)
+                    .empty());
+    EXPECT_FALSE(Sample(block, Mat3::Identity(), Mat3::Zero(), 1.05 * k_strength / B)
+                     .cracks(separation)
+                     .empty());
 }
 
 TEST(Cracks, PorePressureAloneCracksWhenBTimesPReachesTheStrength) {

@@ -1,5 +1,9 @@
 #include "karst/pfem/cracks.hpp"
 
+#include "karst/pfem/p1_tet.hpp"
+
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -26,13 +30,61 @@ Vec3 shared_face_centroid(const TetMesh& mesh, const ElementLink& link) {
 
 }  // namespace
 
+std::vector<std::pair<Real, Vec3>> separation_tensor_ratios(const TetMesh& mesh,
+                                                            const NodalStress& stress,
+                                                            Real tensile_strength) {
+    const Index n = mesh.node_count();
+    std::vector<Mat3> varsigma(n, Mat3::Zero());
+    auto m = [](const Vec3& f) -> Mat3 {
+        const Real length = f.norm();
+        return length > 0 ? Mat3(f * f.transpose() / length) : Mat3::Zero();
+    };
+    std::vector<P1Tet> elements(mesh.tet_count());
+    for (Index e = 0; e < mesh.tet_count(); ++e) {
+        const Tet& t = mesh.tets[e];
+        elements[e] = p1_tet(mesh, e);
+        const Mat3 sigma = 0.25 * (stress.effective[t[0]] + stress.effective[t[1]] +
+                                   stress.effective[t[2]] + stress.effective[t[3]]);
+        const Eigen::SelfAdjointEigenSolver<Mat3> eigen(sigma);
+        const Vec3 lambda = eigen.eigenvalues();
+        const Mat3& V = eigen.eigenvectors();
+        const Mat3 tensile = V * lambda.cwiseMax(0).asDiagonal() * V.transpose();
+        const Mat3 compressive = sigma - tensile;
+        for (int k = 0; k < 4; ++k) {
+            const Vec3 g = elements[e].volume * elements[e].grad[k];
+            varsigma[t[k]] += 0.5 * (m(tensile * g) - m(compressive * g));
+        }
+    }
+    std::vector<std::pair<Real, Vec3>> result(n, {0.0, Vec3::UnitZ()});
+    std::vector<Real> capacity(n, 0);
+    for (Index a = 0; a < n; ++a) {
+        const Eigen::SelfAdjointEigenSolver<Mat3> eigen(varsigma[a]);
+        result[a] = {eigen.eigenvalues()[2], eigen.eigenvectors().col(2)};
+    }
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        for (int k = 0; k < 4; ++k) {
+            const Index a = mesh.tets[e][k];
+            capacity[a] += 0.5 * tensile_strength * elements[e].volume *
+                           std::abs(elements[e].grad[k].dot(result[a].second));
+        }
+    for (Index a = 0; a < n; ++a)
+        result[a].first = capacity[a] > 0 ? result[a].first / capacity[a] : 0;
+    return result;
+}
+
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                                std::span<const Index> node_id, const CrackSettings& settings,
                                const std::function<bool(const Crack&)>& accept) {
     std::vector<Crack> candidates;
+    const bool separation = settings.criterion == CrackCriterion::SeparationTensor;
+    const std::vector<std::pair<Real, Vec3>> separation_test =
+        separation ? separation_tensor_ratios(mesh, stress, settings.tensile_strength)
+                   : std::vector<std::pair<Real, Vec3>>{};
     for (Index a = 0; a < mesh.node_count(); ++a) {
-        Real ratio = stress.principal[a][0] / settings.tensile_strength;
-        Vec3 n = stress.principal_direction[a].normalized();
+        Real ratio = separation ? separation_test[a].first
+                                : stress.principal[a][0] / settings.tensile_strength;
+        Vec3 n = separation ? separation_test[a].second
+                            : Vec3(stress.principal_direction[a].normalized());
         if (!settings.layer_normal.empty()) {
             const Vec3& m = settings.layer_normal[a];
             const Real across = m.dot(stress.effective[a] * m) / settings.strength_across;

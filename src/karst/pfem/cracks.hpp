@@ -19,7 +19,12 @@ struct Crack {
     Real stress_ratio = 0;        ///< sigma'_1 / sigma_t
 };
 
+/// Which nodes crack (docs/method.md §5.5): Rankine on the nodal effective stress (M25), or
+/// O'Brien & Hodgins' separation tensor from the elements' nodal forces.
+enum class CrackCriterion { Rankine, SeparationTensor };
+
 struct CrackSettings {
+    CrackCriterion criterion = CrackCriterion::Rankine;
     Real tensile_strength = 1e5;  ///< sigma_t, Pa
     Real fracture_energy = 10;    ///< G_c, J/m^2
     Real spacing = 0.02;          ///< dx, m
@@ -30,6 +35,19 @@ struct CrackSettings {
     std::vector<Vec3> layer_normal;
     Real strength_across = 1e5;  ///< Pa
 };
+
+/// O'Brien & Hodgins 1999 at each node a: the element forces f_e = -V_e sigma'_e grad N_a, split
+/// by the tensile and compressive parts of sigma'_e (sigma'_e the mean of its nodes'), give
+/// varsigma = 1/2 [sum m(f+_e) - sum m(f-_e)], m(f) = f f^T / |f|. [D] Their unbalanced terms
+/// -m(f+) + m(f-) cancel at a node in equilibrium (f+ = -f-); in a static mesh they are left only
+/// where loads or supports act, and there they made a surface under hydrostatic compression
+/// crack, so they are left out. Returns per
+/// node its largest eigenvalue over the value sigma_t gives it in a uniform uniaxial stress along
+/// its eigenvector, sigma_t / 2 sum V_e |grad N_a . n| (so that uniaxial tension cracks at
+/// sigma_t, as Rankine does), and that eigenvector.
+std::vector<std::pair<Real, Vec3>> separation_tensor_ratios(const TetMesh& mesh,
+                                                            const NodalStress& stress,
+                                                            Real tensile_strength);
 
 /// M25: nodes whose largest effective principal stress exceeds sigma_t (or, with weak layers,
 /// whose normal stress across the layers exceeds the strength across them: a crack along the

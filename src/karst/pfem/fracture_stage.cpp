@@ -77,6 +77,8 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     settings.fracture_energy = material.fracture_energy;
     settings.spacing = model.dx, settings.exclusion = model.h;
     settings.max_cracks = model.scene.fracture.max_cracks_per_call;
+    if (model.scene.fracture.separation_tensor)
+        settings.criterion = CrackCriterion::SeparationTensor;
     if (material.strength_across) {
         settings.strength_across = *material.strength_across;
         settings.layer_normal = layer_normals(s.node_tensors, material.layering_ratio);

@@ -235,6 +235,8 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];
     s.fracture.enabled = doc["fracture"]["enabled"],
     s.fracture.max_cracks_per_call = doc["fracture"]["max_cracks_per_call"];
+    s.fracture.separation_tensor = option<bool>(doc["fracture"]["criterion"],
+                                                {{"rankine", false}, {"separation_tensor", true}});
     s.fracture.merge = doc["fracture"]["merge"];
     s.fracture.merge_saturation = doc["fracture"]["merge_saturation"];
     s.fracture.merge_speed = doc["fracture"]["merge_speed"];

@@ -148,6 +148,7 @@ struct PoroelasticSettings {
 struct FractureSettings {
     bool enabled{};
     int max_cracks_per_call{};  ///< N_crack
+    bool separation_tensor{};   ///< O'Brien & Hodgins' criterion instead of Rankine (M25)
     bool merge{};               ///< wet fragments in slow contact join (§5.6)
     Real merge_saturation{};    ///< S_merge: mean saturation of the contact particles
     Real merge_speed{};         ///< v_merge: largest closing speed of a contact pair, m/s

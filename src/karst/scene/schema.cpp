@@ -351,6 +351,12 @@ std::vector<KeySpec> make_schema() {
         key("/fracture/max_cracks_per_call", T::Integer, "", closed(1, 1000), 8,
             "N_crack: most cracks per structure and Biot call, taken in decreasing "
             "sigma'_1 / sigma_t; none within h of another crack of the same call."),
+        key("/fracture/criterion", T::Enum, "", any(), "rankine",
+            "rankine: a node cracks when its largest effective principal stress exceeds the "
+            "tensile strength (M25); separation_tensor: O'Brien & Hodgins' separation tensor of "
+            "the elements' tensile and compressive nodal forces, scaled so that uniaxial tension "
+            "cracks at the same strength (docs/method.md §5.5).",
+            {"rankine", "separation_tensor"}),
         key("/fracture/merge", T::Bool, "", any(), true,
             "Fragments that touch while wet join again (docs/method.md §5.6): the mean saturation "
             "of their touching particles at least merge_saturation, every touching pair closing "
