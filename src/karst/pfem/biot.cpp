@@ -53,7 +53,8 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
                       p_dofs.free_count >= options.amg_flow_unknowns);
     if (u_dofs.free_count > 0)
         elastic.compute(tie.cols() > 0 ? SparseMatrix(tie.transpose() * K_ff * tie) : K_ff,
-                        elastic_iterative, elastic_iterative ? elastic_amg_options() : AmgOptions{});
+                        elastic_iterative,
+                        elastic_iterative ? elastic_amg_options() : AmgOptions{});
     t_elastic_factor = factor_watch.seconds();
 }
 
