@@ -68,7 +68,9 @@ public:
 
 private:
     friend class ArchiveBase<ArchiveWriter>;
-    void raw(const void* data, size_t n) { m_bytes.append(static_cast<const char*>(data), n); }
+    void raw(const void* data, size_t n) {
+        if (n > 0) m_bytes.append(static_cast<const char*>(data), n);  // empty: data may be null
+    }
     template <class C>
     void sequence(C& c) {
         std::uint64_t n = c.size();
@@ -98,6 +100,7 @@ private:
         if (n > left())
             throw ArchiveError("the file ends " + std::to_string(n - left()) +
                                " bytes early (truncated or damaged)");
+        if (n == 0) return;  // an empty vector's data() may be null, which memcpy may not take
         std::memcpy(data, m_bytes.data() + m_at, n);
         m_at += n;
     }
