@@ -10,6 +10,8 @@ packages=(
     libtbb-dev               # the one parallel runtime
     libsuitesparse-dev libopenblas0-pthread   # CHOLMOD; OpenBLAS makes it 15x faster than reference BLAS
     libhypre-dev             # BoomerAMG for large Biot systems (brings Open MPI)
+    libopenvdb-dev           # sparse grids and VolumeToMesh for the fluid surface
+    povray ffmpeg            # karst render: PNG frames and the MP4
     nlohmann-json3-dev       # scene files
     zlib1g-dev               # compressed VTK frames
     libcli11-dev             # command line

@@ -1,4 +1,5 @@
 // The karst command line: maps flags to options and calls the library; nothing else.
+#include "karst/render/render.hpp"
 #include "karst/scene/scene.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/scene/schema.hpp"
@@ -51,6 +52,24 @@ int main(int argc, char** argv) {
                   "Write into a non-empty output folder that no karst run wrote (only karst's "
                   "own file names are replaced)");
 
+    bool render_after = false;
+    karst::RenderOptions render_options;
+    run->add_flag("--render", render_after,
+                  "Render the run's surfaces to PNG frames and movie.mp4 when it ends (as "
+                  "karst render)");
+    std::string render_dir;
+    CLI::App* render = app.add_subcommand(
+        "render", "Render a run's surfaces to render_NNNN.png and movie.mp4 (POV-Ray, ffmpeg)");
+    render->add_option("out_dir", render_dir, "Output folder of a run")->required();
+    for (CLI::App* cmd : {run, render}) {
+        cmd->add_flag("--preview", render_options.preview,
+                      "Fast render: no refraction, soft shadows or anti-aliasing");
+        cmd->add_option("--width", render_options.width, "Frame width in pixels (default 1280)")
+            ->check(CLI::Range(16, 7680));
+        cmd->add_option("--height", render_options.height, "Frame height in pixels (default 720)")
+            ->check(CLI::Range(16, 4320));
+    }
+
     std::string check_path;
     CLI::App* check = app.add_subcommand("check", "Validate a scene and print its particle counts");
     check->add_option("scene", check_path, "Scene file (JSON)")->required();
@@ -88,6 +107,12 @@ int main(int argc, char** argv) {
                 model.domain.min[2], model.domain.max[0], model.domain.max[1], model.domain.max[2]);
             return 0;
         }
+        if (app.got_subcommand("render")) {
+            const karst::RenderResult r = karst::render_run(render_dir, render_options);
+            fmt::print("karst: rendered {} frames ({:.2f} s each) and {}\n", r.frames,
+                       r.seconds_per_frame, r.movie.string());
+            return 0;
+        }
         if (!out_dir.empty()) run_options.out_dir = out_dir;
         run_options.end_time = end_time, run_options.fps = fps;
         run_options.checkpoint_every = checkpoint_every;
@@ -112,6 +137,13 @@ int main(int argc, char** argv) {
                        result.stats["frames"].get<int>(), result.out_dir.string(),
                        result.stats["wall_time"].get<double>(),
                        result.stats["mipps"].get<double>());
+        if (render_after) {
+            render_options.threads = run_options.threads;
+            const karst::RenderResult r = karst::render_run(result.out_dir, render_options);
+            if (!run_options.quiet)
+                fmt::print(stderr, "karst: rendered {} frames ({:.2f} s each) and {}\n", r.frames,
+                           r.seconds_per_frame, r.movie.string());
+        }
         return 0;
     } catch (const karst::SceneError& e) {
         fmt::print(stderr, "karst: {}\n", e.what());

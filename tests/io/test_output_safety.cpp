@@ -145,7 +145,8 @@ TEST(OutputSafety, EachOutputPartIsSwitchedByItsOwnKey) {
         "constraints": [{ "kind": "fixed", "region": { "type": "box", "min": [-1,-1,-1], "max": [2,2,0] } }] }],
       "walls": [{ "kind": "obstacle", "shape": { "type": "box", "min": [1,1,1], "max": [1.2,1.2,1.2] } }],
       "poroelastic": { "time_step": 0.05 },
-      "output": { "fps": 20, "vtp": false, "porous": false, "mesh": true, "walls": false }
+      "output": { "fps": 20, "vtp": false, "porous": false, "mesh": true, "walls": false,
+                  "porous_surface": false }
     })";
     const fs::path out = box.path / "out";
     ASSERT_EQ(shell(karst() + " run " + (box.path / "block.json").string() + " --quiet --out " +
@@ -154,6 +155,7 @@ TEST(OutputSafety, EachOutputPartIsSwitchedByItsOwnKey) {
     EXPECT_TRUE(fs::exists(out / "mesh_0002.vtu"));
     EXPECT_FALSE(fs::exists(out / "porous_0000.vtp"));
     EXPECT_FALSE(fs::exists(out / "boundary.vtp"));
+    EXPECT_FALSE(fs::exists(out / "porous_surface_0000.ply"));
     const std::string pvd = read_text(out / "run.pvd");
     EXPECT_NE(pvd.find("mesh_0002.vtu"), std::string::npos);
     EXPECT_EQ(pvd.find("porous_"), std::string::npos);

@@ -30,7 +30,8 @@ FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings, FrameHist
         if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
             return false;
         const std::string ext = name.substr(dot);
-        return (ext == ".vtp" || ext == ".vtu" || ext == ".ply") && std::stoll(digits) >= kept;
+        return (ext == ".vtp" || ext == ".vtu" || ext == ".ply" || ext == ".vdb") &&
+               std::stoll(digits) >= kept;
     });
 }
 
@@ -64,6 +65,8 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         for (Index i = 0; i < fluid.size(); ++i) concentration[i] = fluid.solute[i] / fluid.mass[i];
         points.add_scalar("concentration", concentration);
         points.add_integer("id", fluid.id);
+        if (parts.pscale > 0)
+            points.add_scalar("pscale", std::vector<Real>(fluid.size(), parts.pscale));
         if (m_settings.vtp)
             m_folder.write(fmt::format("fluid_{:04d}.vtp", frame),
                            vtp_bytes(points, m_settings.compress));
@@ -81,13 +84,24 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         m_folder.write(fmt::format("cracks_{:04d}.vtp", frame),
                        vtp_polygons_bytes(parts.cracks->vertices, parts.cracks->polygons,
                                           m_settings.compress));
-    m_history.written.push_back({fluid_part && m_settings.vtp, mesh, porous, cracks});
+    const bool fluid_surface = parts.fluid_surface && m_settings.fluid_surface;
+    const bool porous_surface = parts.porous_surface && m_settings.porous_surface;
+    if (fluid_surface)
+        write_surface(fmt::format("fluid_surface_{:04d}", frame), *parts.fluid_surface);
+    if (porous_surface)
+        write_surface(fmt::format("porous_surface_{:04d}", frame), *parts.porous_surface);
+    if (parts.level_set && m_settings.level_set)
+        m_folder.write(fmt::format("fluid_level_set_{:04d}.vdb", frame), *parts.level_set);
+    m_history.written.push_back(
+        {fluid_part && m_settings.vtp, mesh, porous, cracks, fluid_surface, porous_surface});
     const std::vector<FrameLog>& rows = m_history.log;
     const std::vector<FrameHistory::Written>& written = m_history.written;
     const bool boundary = m_history.has_boundary;
 
-    if (boundary || m_settings.vtp || m_settings.mesh || m_settings.porous || m_settings.cracks) {
-        // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles, 4 cracks.
+    if (boundary || m_settings.vtp || m_settings.mesh || m_settings.porous || m_settings.cracks ||
+        m_settings.fluid_surface || m_settings.porous_surface) {
+        // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles, 4 cracks, 5 fluid surface,
+        // 6 porous surface.
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {
             if (written[f].fluid)
@@ -99,6 +113,10 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
                 entries.push_back({rows[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
             if (written[f].cracks)
                 entries.push_back({rows[f].time, 4, fmt::format("cracks_{:04d}.vtp", f)});
+            if (written[f].fluid_surface)
+                entries.push_back({rows[f].time, 5, fmt::format("fluid_surface_{:04d}.vtp", f)});
+            if (written[f].porous_surface)
+                entries.push_back({rows[f].time, 6, fmt::format("porous_surface_{:04d}.vtp", f)});
         }
         m_folder.write("run.pvd", pvd_bytes(entries));
     }
@@ -140,6 +158,22 @@ CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
     frame.vertices.add_scalar("area", area);
     frame.vertices.add_scalar("time", time);
     return frame;
+}
+
+void FrameWriter::write_surface(const std::string& stem, const SurfaceMesh& mesh) {
+    m_folder.write(stem + ".ply", ply_bytes(mesh));
+    // VTK gets the colour as a float RGB array in [0, 1] (ParaView: untick Map Scalars).
+    PointSet vertices = mesh.vertices;
+    if (!mesh.colour.empty()) {
+        std::vector<Vec3> colour(mesh.colour.size());
+        for (size_t v = 0; v < colour.size(); ++v)
+            colour[v] = Vec3(mesh.colour[v][0], mesh.colour[v][1], mesh.colour[v][2]) / 255;
+        vertices.add_vector("colour", colour);
+    }
+    std::vector<std::vector<Index>> polygons(mesh.triangles.size());
+    for (size_t f = 0; f < polygons.size(); ++f)
+        polygons[f].assign(mesh.triangles[f].begin(), mesh.triangles[f].end());
+    m_folder.write(stem + ".vtp", vtp_polygons_bytes(vertices, polygons, m_settings.compress));
 }
 
 void FrameWriter::write_stats(const nlohmann::json& stats) {

@@ -7,6 +7,7 @@
 #include "karst/scene/scene.hpp"
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
+#include "karst/surface/surface_mesh.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -52,12 +53,17 @@ struct FrameParts {
     const MeshFrame* mesh = nullptr;
     const PointSet* porous = nullptr;    ///< porous particles with their pore state
     const CrackFrame* cracks = nullptr;  ///< written once some crack exists
+    const SurfaceMesh* fluid_surface = nullptr;
+    const SurfaceMesh* porous_surface = nullptr;
+    const std::string* level_set = nullptr;  ///< the fluid level set, .vdb bytes
+    Real pscale = 0;                         ///< fluid particle radius in the PLY points, m
 };
 
 /// The frames written so far: what run.pvd and log.csv list (a checkpoint keeps it).
 struct FrameHistory {
     struct Written {
         bool fluid = false, mesh = false, porous = false, cracks = false;
+        bool fluid_surface = false, porous_surface = false;
     };
     std::vector<FrameLog> log;
     std::vector<Written> written;  ///< which parts each frame has
@@ -73,8 +79,9 @@ public:
     /// frame files it wrote after them are removed, the rest is kept.
     FrameWriter(std::filesystem::path dir, const OutputSettings& settings, FrameHistory history);
     void write_boundary(const WallParticles& walls);
-    /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu, porous_NNNN.vtp and cracks_NNNN.vtp as present, then
-    /// run.pvd and log.csv anew.
+    /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu, porous_NNNN.vtp, cracks_NNNN.vtp,
+    /// fluid_surface_NNNN.ply/.vtp, porous_surface_NNNN.ply/.vtp and fluid_level_set_NNNN.vdb as
+    /// present, then run.pvd and log.csv anew.
     void write_frame(const FrameParts& parts, const FrameLog& log);
     void write_stats(const nlohmann::json& stats);
     int frames() const { return int(m_history.log.size()); }
@@ -83,6 +90,8 @@ public:
     const std::filesystem::path& dir() const { return m_folder.dir(); }
 
 private:
+    /// <stem>.ply and <stem>.vtp of a surface.
+    void write_surface(const std::string& stem, const SurfaceMesh& mesh);
     OutputFolder m_folder;
     OutputSettings m_settings;
     FrameHistory m_history;

@@ -36,6 +36,7 @@ std::vector<PcaFrame> pca_frames(const std::vector<Vec3>& x, Real h) {
         const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);  // ascending
         PcaFrame& f = frames[i];
         f.neighbours = neighbours.count[i];
+        f.mean = mean;
         f.spread = eigen.eigenvalues().reverse();
         f.axes = eigen.eigenvectors().rowwise().reverse();
     });

@@ -1,7 +1,8 @@
 #pragma once
 // Weighted PCA of a particle's neighbourhood (docs/method.md §6.2, Yu & Turk 2013, M28): the local
-// frame of complex geometry. karst uses it only for the layering frame ("axes from geometry");
-// the permeability ratios come from the scene through K0 (M12), never from sampling noise.
+// frame of complex geometry. karst uses it for the layering frame ("axes from geometry"; the
+// permeability ratios come from the scene through K0, M12, never from sampling noise) and for the
+// anisotropic kernels of the fluid surface (§7).
 #include "karst/core/types.hpp"
 
 #include <vector>
@@ -12,6 +13,7 @@ struct PcaFrame {
     Mat3 axes = Mat3::Identity();  ///< columns: directions of largest, middle and least spread
     Vec3 spread = Vec3::Ones();  ///< sigma_1 >= sigma_2 >= sigma_3 of the weighted covariance, m^2
     Index neighbours = 0;        ///< particles within r_i = 2 h, itself included
+    Vec3 mean = Vec3::Zero();    ///< x^w, the weighted mean of the neighbours, m
     /// Enough neighbours (N > N_eps = 25) for the frame to mean anything.
     bool reliable() const { return neighbours > 25; }
     /// The layering normal of a sheet-like neighbourhood: the direction of least spread.

@@ -244,6 +244,11 @@ Scene parse_scene(const std::string& text) {
     s.output.ply = doc["output"]["ply"], s.output.compress = doc["output"]["compress"];
     s.output.porous = doc["output"]["porous"], s.output.mesh = doc["output"]["mesh"];
     s.output.walls = doc["output"]["walls"], s.output.cracks = doc["output"]["cracks"];
+    s.output.fluid_surface = doc["output"]["fluid_surface"],
+    s.output.porous_surface = doc["output"]["porous_surface"];
+    s.output.level_set = doc["output"]["level_set"];
+    s.output.surface_voxel = doc["output"]["surface_voxel"];
+    s.output.anisotropic_surface = doc["output"]["anisotropic_surface"];
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];
     s.fingerprint = scene_fingerprint(doc);

@@ -160,6 +160,10 @@ struct OutputSettings {
     bool ply{};
     bool porous{}, mesh{}, walls{}, cracks{};  ///< which VTK parts are written
     bool compress{};                           ///< zlib blocks in the VTK frames
+    bool fluid_surface{}, porous_surface{};    ///< surface meshes (docs/method.md §7)
+    bool level_set{};                          ///< the fluid level set as .vdb
+    Real surface_voxel{};                      ///< fluid surface grid spacing / dx
+    bool anisotropic_surface{};                ///< Yu-Turk kernels for the fluid surface
 };
 
 struct Scene {

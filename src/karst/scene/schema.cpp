@@ -383,6 +383,20 @@ std::vector<KeySpec> make_schema() {
             "cannot be compressed and would more than double the output)."),
         key("/output/compress", T::Bool, "", any(), true,
             "zlib-compress the VTK frames (ParaView and every VTK reader read both kinds)."),
+        key("/output/fluid_surface", T::Bool, "", any(), true,
+            "Write the fluid surface (docs/method.md §7), fluid_surface_NNNN.ply and .vtp: "
+            "triangles with normal, velocity, concentration and the M29 colour."),
+        key("/output/porous_surface", T::Bool, "", any(), true,
+            "Write each fragment's alpha-shape surface, porous_surface_NNNN.ply and .vtp, with "
+            "saturation, porosity and the M29 colour (wet is darker)."),
+        key("/output/level_set", T::Bool, "", any(), false,
+            "Also write the fluid's level set phi = 0.5 - c (negative inside), "
+            "fluid_level_set_NNNN.vdb, for Houdini and Blender volume workflows."),
+        key("/output/surface_voxel", T::Number, "", closed(0.1, 2), 0.5,
+            "The fluid surface's grid spacing, as a fraction of particle_spacing."),
+        key("/output/anisotropic_surface", T::Bool, "", any(), false,
+            "Yu-Turk anisotropic kernels for the fluid surface: thin sheets and splashes stay "
+            "sheets instead of beads, at about twice the meshing time."),
 
         key("/watchdog", T::Object, "", any(), json::object(), "Run-time sanity limits."),
         key("/watchdog/max_speed", T::Number, "m/s", positive(1e6), 100.0,

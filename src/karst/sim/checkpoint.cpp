@@ -106,7 +106,7 @@ void fields(Ar& ar, FrameLog& l) {
 
 template <class Ar>
 void fields(Ar& ar, FrameHistory::Written& w) {
-    ar(w.fluid, w.mesh, w.porous, w.cracks);
+    ar(w.fluid, w.mesh, w.porous, w.cracks, w.fluid_surface, w.porous_surface);
 }
 
 template <class Ar>

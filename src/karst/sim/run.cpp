@@ -19,6 +19,8 @@
 #include "karst/sph/density.hpp"
 #include "karst/sph/fluid_neighbours.hpp"
 #include "karst/sph/integrate.hpp"
+#include "karst/surface/fluid_frame.hpp"
+#include "karst/surface/porous_surface.hpp"
 
 #include <fmt/format.h>
 
@@ -83,6 +85,13 @@ PointSet porous_frame(const Model& model, const State& state) {
         if (size_t(p.id[i]) < damage.size()) broken[i] = damage[p.id[i]];
     points.add_integer("damage", broken);
     return points;
+}
+
+/// The values of a named array of `points`.
+std::vector<Real> point_array(const PointSet& points, const std::string& name) {
+    for (const PointArray& a : points.arrays)
+        if (a.name == name) return a.values;
+    throw std::logic_error("no point array " + name);
 }
 
 /// A flag that overrides a scene key obeys the key's range, and says so with the flag's name.
@@ -226,6 +235,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     const bool fluid_frames = !model.poroelastic_only();
 
     ProgressLine progress(opt.quiet);
+    PorousSurfaces porous_surfaces;  // each fragment's triangles, kept while its members stay
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
         log.kinetic_energy = e.kinetic, log.potential_energy = e.potential,
@@ -259,9 +269,22 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         MeshFrame mesh;
         if (meshes) append_structure_meshes(model, state, mesh);
         const CrackFrame cracks = crack_frame(state.structures.cracks);
-        out->write_frame({fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr,
-                          porous ? &porous_points : nullptr, &cracks},
-                         log);
+        const OutputSettings& o = scene.output;
+        SurfaceMesh fluid_surface, porous_surface;
+        std::string level_set;
+        if (fluid_frames && o.fluid_surface)
+            fluid_surface =
+                fluid_frame_surface(model, state.fluid, o.level_set ? &level_set : nullptr);
+        if (porous && o.porous_surface)
+            porous_surface = porous_surfaces.build(model, state.porous.particles,
+                                                   point_array(porous_points, "saturation"));
+        FrameParts parts{fluid_frames ? &state.fluid : nullptr, meshes ? &mesh : nullptr,
+                         porous ? &porous_points : nullptr, &cracks};
+        if (fluid_frames && o.fluid_surface) parts.fluid_surface = &fluid_surface;
+        if (porous && o.porous_surface) parts.porous_surface = &porous_surface;
+        if (fluid_frames && o.level_set) parts.level_set = &level_set;
+        parts.pscale = 0.5 * model.dx;
+        out->write_frame(parts, log);
     };
     // The checkpoint of the state now, and only the newest --checkpoint-keep of them kept.
     auto write_checkpoint = [&] {

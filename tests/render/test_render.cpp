@@ -1,0 +1,79 @@
+// `karst render` (issue 14): a cave_soak run renders to one PNG per frame and an MP4 whose frame
+// count ffprobe confirms, and a frame shows water and rock, not a blank picture.
+#include "support/files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <filesystem>
+
+namespace karst {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool on_path(const char* tool) {
+    return std::system(fmt::format("command -v {} > /dev/null 2>&1", tool).c_str()) == 0;
+}
+
+/// The text a shell command prints.
+std::string output_of(const std::string& command) {
+    std::string out;
+    if (FILE* pipe = popen(command.c_str(), "r")) {
+        char buffer[4096];
+        for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) out.append(buffer, n);
+        pclose(pipe);
+    }
+    return out;
+}
+
+TEST(Render, TheCaveSoakRendersAFramePerSurfaceAndAMovie) {
+    for (const char* tool : {"povray", "ffmpeg", "ffprobe"})
+        if (!on_path(tool))
+            GTEST_SKIP() << tool << " is not installed (scripts/install_deps.sh installs it)";
+    const test::TempDir dir("render");
+    const fs::path out = dir.path / "out";
+    const std::string karst = KARST_BINARY;
+    ASSERT_EQ(test::exit_code_of(karst + " run " + KARST_SOURCE_DIR +
+                                 "/scenes/cave_soak.json --quiet --end-time 0.1 --fps 20 --out " +
+                                 out.string() + " --render --preview --width 320 --height 180"),
+              0);
+    int pngs = 0;
+    for (const auto& e : fs::directory_iterator(out)) pngs += e.path().extension() == ".png";
+    EXPECT_EQ(pngs, 3);  // frames at 0, 0.05 and 0.1 s
+    const std::string frames = output_of(
+        "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+        "stream=nb_read_frames,codec_name,pix_fmt -of csv=p=0 " +
+        (out / "movie.mp4").string());
+    EXPECT_EQ(frames, "h264,yuv420p,3\n");
+
+    // The last frame's pixels: bluish water and sandy rock are both there.
+    const std::string rgb = output_of("ffmpeg -v error -i " + (out / "render_0002.png").string() +
+                                      " -f rawvideo -pix_fmt rgb24 -");
+    ASSERT_EQ(rgb.size(), 320u * 180 * 3);
+    int water = 0, rock = 0;
+    for (size_t p = 0; p < rgb.size(); p += 3) {
+        const int r = std::uint8_t(rgb[p]), g = std::uint8_t(rgb[p + 1]),
+                  b = std::uint8_t(rgb[p + 2]);
+        water += b > r + 25 && b >= g;
+        rock += r > b + 40 && g > b + 15;
+    }
+    EXPECT_GT(water, 200);  // the 0.1 m water cube covers about 1,400 pixels
+    EXPECT_GT(rock, 5000);
+    // The manifest lists the renders: a rerun into the folder removes them.
+    const std::string manifest = test::read_text(out / "manifest.txt");
+    EXPECT_NE(manifest.find("render_0002.png"), std::string::npos);
+    EXPECT_NE(manifest.find("movie.mp4"), std::string::npos);
+}
+
+TEST(Render, AFolderWithoutSurfacesIsRefusedWithTheReason) {
+    const test::TempDir dir("render_empty");
+    std::string err;
+    EXPECT_EQ(test::exit_code_of(std::string(KARST_BINARY) + " render " + dir.path.string(), &err),
+              1);
+    EXPECT_NE(err.find("no surface frames"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace karst
