@@ -9,7 +9,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include <algorithm>
 #include <mutex>
@@ -29,7 +29,7 @@ struct Splat {
     Vec3 centre;
     Mat3 G;
     Real weight;  ///< V det G, 1/m^0
-    Real reach;   ///< radius of the sphere holding the kernel's ellipsoid, m
+    Vec3 reach;   ///< half-edges of the box holding the kernel's ellipsoid |G r| < 1, m
 };
 
 Real unit_cubic(Real q) {
@@ -44,16 +44,17 @@ std::vector<Splat> make_splats(const std::vector<Vec3>& x, const std::vector<Rea
     std::vector<Splat> s(x.size());
     if (!anisotropic) {
         parallel_for(Index(x.size()), [&](Index i) {
-            s[i] = {x[i], Mat3::Identity() / h, volume[i] / (h * h * h), h};
+            s[i] = {x[i], Mat3::Identity() / h, volume[i] / (h * h * h), Vec3::Constant(h)};
         });
         return s;
     }
     const std::vector<PcaFrame> frames = pca_frames(x, h);
     parallel_for(Index(x.size()), [&](Index i) {
         const Mat3 G = pca_kernel_tensor(frames[i], h);
-        const Real smallest = Eigen::SelfAdjointEigenSolver<Mat3>(G).eigenvalues()[0];
+        // r = G^-1 u with |u| < 1: the ellipsoid reaches |row d of G^-1| along axis d.
+        const Vec3 reach = G.inverse().rowwise().norm();
         const Vec3 centre = x[i] + k_smoothing * (frames[i].mean - x[i]);
-        s[i] = {centre, G, volume[i] * G.determinant(), 1 / smallest};
+        s[i] = {centre, G, volume[i] * G.determinant(), reach};
     });
     return s;
 }
@@ -94,8 +95,8 @@ struct Bins {
 std::array<int, 6> voxel_box(const Splat& s, Real voxel) {
     std::array<int, 6> b;
     for (int d = 0; d < 3; ++d) {
-        b[d] = int(std::ceil((s.centre[d] - s.reach) / voxel));
-        b[d + 3] = int(std::floor((s.centre[d] + s.reach) / voxel));
+        b[d] = int(std::ceil((s.centre[d] - s.reach[d]) / voxel));
+        b[d + 3] = int(std::floor((s.centre[d] + s.reach[d]) / voxel));
     }
     return b;
 }
@@ -169,16 +170,18 @@ void fill_leaf(const std::array<int, 3>& leaf, int reach, const Bins& bins,
                         empty |= box[d] > box[d + 3];
                     }
                     if (empty) continue;
+                    // G (p - centre) along a row of voxels in z: a start and a fixed step.
+                    const Vec3 step = voxel * s.G.col(2);
                     for (int i = box[0]; i <= box[3]; ++i)
-                        for (int j = box[1]; j <= box[4]; ++j)
-                            for (int l = box[2]; l <= box[5]; ++l) {
-                                const Vec3 p = voxel * Vec3(i, j, l);
-                                const Real q = (s.G * (p - s.centre)).norm();
-                                if (q >= 1) continue;
-                                // OpenVDB's leaf offset: z fastest, then y, then x.
-                                c[(i - lo[0]) << 6 | (j - lo[1]) << 3 | (l - lo[2])] +=
-                                    s.weight * unit_cubic(q);
+                        for (int j = box[1]; j <= box[4]; ++j) {
+                            Vec3 u = s.G * (voxel * Vec3(i, j, box[2]) - s.centre);
+                            // OpenVDB's leaf offset: z fastest, then y, then x.
+                            double* row = c.data() + ((i - lo[0]) << 6 | (j - lo[1]) << 3);
+                            for (int l = box[2]; l <= box[5]; ++l, u += step) {
+                                const Real q2 = u.squaredNorm();
+                                if (q2 < 1) row[l - lo[2]] += s.weight * unit_cubic(std::sqrt(q2));
                             }
+                        }
                 }
             }
 }
@@ -187,8 +190,9 @@ openvdb::FloatGrid::Ptr level_set_grid(const std::vector<Splat>& splats, Real vo
     const Bins bins = bin_splats(splats, voxel);
     const std::vector<std::uint64_t> keys = reached_leaves(bins);
     Real reach = 0;
-    for (const Splat& s : splats) reach = std::max(reach, s.reach);
-    const int bin_reach = int(std::ceil(reach / (voxel * k_leaf))) + 1;
+    for (const Splat& s : splats) reach = std::max(reach, s.reach.maxCoeff());
+    // A bin's centres lie within half a voxel of its leaf, so its kernels reach this many leaves.
+    const int bin_reach = int(std::ceil((reach / voxel + 0.5) / k_leaf));
 
     std::vector<std::unique_ptr<Leaf>> leaves(keys.size());
     parallel_for(Index(keys.size()), [&](Index k) {
