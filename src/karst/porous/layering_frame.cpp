@@ -14,28 +14,28 @@ std::vector<PcaFrame> pca_frames(const std::vector<Vec3>& x, Real h) {
     const UniformGrid grid(box.padded(radius), radius);
     CellRanges cells;
     sort_into_cells(grid, x, cells);
-    NeighbourLists neighbours;
-    find_neighbours(grid, x, cells, false, neighbours);  // itself included
 
+    // About 270 neighbours within 2 h = 4 dx: visited in place (itself included), not listed.
     std::vector<PcaFrame> frames(x.size());
     parallel_for(Index(x.size()), [&](Index i) {
         Real weight = 0;
         Vec3 mean = Vec3::Zero();
-        neighbours.for_each(i, [&](Index j) {
-            const Real r = (x[j] - x[i]).norm() / radius, w = 1 - r * r * r;
-            weight += w, mean += w * x[j];
+        Index count = 0;
+        for_each_within(grid, cells, x[i], [&](Index, const Vec3& xj) {
+            const Real r = (xj - x[i]).norm() / radius, w = 1 - r * r * r;
+            weight += w, mean += w * xj, ++count;
         });
         mean /= weight;
         Mat3 covariance = Mat3::Zero();
-        neighbours.for_each(i, [&](Index j) {
-            const Real r = (x[j] - x[i]).norm() / radius, w = 1 - r * r * r;
-            const Vec3 d = x[j] - mean;
+        for_each_within(grid, cells, x[i], [&](Index, const Vec3& xj) {
+            const Real r = (xj - x[i]).norm() / radius, w = 1 - r * r * r;
+            const Vec3 d = xj - mean;
             covariance += w * d * d.transpose();
         });
         covariance /= weight;
         const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);  // ascending
         PcaFrame& f = frames[i];
-        f.neighbours = neighbours.count[i];
+        f.neighbours = count;
         f.mean = mean;
         f.spread = eigen.eigenvalues().reverse();
         f.axes = eigen.eigenvectors().rowwise().reverse();

@@ -6,6 +6,7 @@
 #include "karst/core/types.hpp"
 #include "karst/scene/geometry.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -57,6 +58,24 @@ struct NeighbourLists {
 /// The capacity grows (and the search repeats) when a particle has more neighbours.
 void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
                      const CellRanges& targets, bool exclude_self, NeighbourLists& out);
+
+/// Calls f(j, x_j) for every particle j of `targets` closer to `at` than grid.cell (strictly), in
+/// the order find_neighbours lists them, without storing a list: for wide searches whose lists
+/// would not fit in memory.
+template <class F>
+void for_each_within(const UniformGrid& grid, const CellRanges& targets, const Vec3& at,
+                     const F& f) {
+    const Real h2 = grid.cell * grid.cell;
+    const auto c = grid.coords(at);
+    const int x0 = std::max(c[0] - 1, 0), x1 = std::min(c[0] + 1, grid.dims[0] - 1);
+    for (int z = std::max(c[2] - 1, 0); z <= std::min(c[2] + 1, grid.dims[2] - 1); ++z)
+        for (int y = std::max(c[1] - 1, 0); y <= std::min(c[1] + 1, grid.dims[1] - 1); ++y)
+            for (std::uint32_t s = targets.start[grid.linear({x0, y, z})],
+                               e = targets.start[grid.linear({x1, y, z}) + 1];
+                 s < e; ++s)
+                if ((targets.sorted_x[s] - at).squaredNorm() < h2)
+                    f(Index(targets.order[s]), targets.sorted_x[s]);
+}
 
 /// Permutation sorting `x` along the Morton curve of their grid cells (ties by index).
 std::vector<std::uint32_t> morton_order(const UniformGrid& grid, const std::vector<Vec3>& x);

@@ -268,22 +268,13 @@ std::vector<std::vector<Real>> shepard_interpolate(const std::vector<Vec3>& at,
     sort_into_cells(grid, x, cells);
     const CubicKernel kernel(support);
     parallel_for(Index(at.size()), [&](Index i) {
-        const auto c = grid.coords(at[i]);
         Real weight = 0;
         std::vector<Real> sum(columns.size(), 0);
-        for (int z = std::max(c[2] - 1, 0); z <= std::min(c[2] + 1, grid.dims[2] - 1); ++z)
-            for (int y = std::max(c[1] - 1, 0); y <= std::min(c[1] + 1, grid.dims[1] - 1); ++y) {
-                const int x0 = std::max(c[0] - 1, 0), x1 = std::min(c[0] + 1, grid.dims[0] - 1);
-                for (std::uint32_t s = cells.start[grid.linear({x0, y, z})],
-                                   e = cells.start[grid.linear({x1, y, z}) + 1];
-                     s < e; ++s) {
-                    const Index j = cells.order[s];
-                    const Real w = volume[j] * kernel.w((at[i] - cells.sorted_x[s]).norm());
-                    if (w <= 0) continue;
-                    weight += w;
-                    for (size_t k = 0; k < columns.size(); ++k) sum[k] += w * columns[k][j];
-                }
-            }
+        for_each_within(grid, cells, at[i], [&](Index j, const Vec3& xj) {
+            const Real w = volume[j] * kernel.w((at[i] - xj).norm());
+            weight += w;
+            for (size_t k = 0; k < columns.size(); ++k) sum[k] += w * columns[k][j];
+        });
         if (weight > 0)
             for (size_t k = 0; k < columns.size(); ++k) out[k][i] = sum[k] / weight;
     });
