@@ -64,9 +64,11 @@ int main(int argc, char** argv) {
     for (CLI::App* cmd : {run, render}) {
         cmd->add_flag("--preview", render_options.preview,
                       "Fast render: no refraction, soft shadows or anti-aliasing");
-        cmd->add_option("--width", render_options.width, "Frame width in pixels (default 1280)")
+        cmd->add_option("--width", render_options.width,
+                        "Frame width in pixels (default /render/width)")
             ->check(CLI::Range(16, 7680));
-        cmd->add_option("--height", render_options.height, "Frame height in pixels (default 720)")
+        cmd->add_option("--height", render_options.height,
+                        "Frame height in pixels (default /render/height)")
             ->check(CLI::Range(16, 4320));
     }
 

@@ -6,6 +6,7 @@
 #include "karst/scene/geometry.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -94,33 +95,39 @@ std::string mesh2(const SurfaceMesh& mesh, const std::string& material, const ch
 
 struct Camera {
     Vec3 location, target, sun;
-    Real ground = 0, scale = 1;
+    Real ground = 0, scale = 1, fov = 40;
 };
 
-Camera frame_camera(const Aabb& box, Real aspect) {
+/// The camera of `settings`, its missing parts framed on `box`: seen from the front left and
+/// above, at 0.85 of the distance at which the box's bounding sphere fills the narrower field of
+/// view (a box's picture is smaller than its sphere's).
+Camera frame_camera(const Aabb& box, const RenderSettings& settings, Real aspect) {
     Camera c;
     const Vec3 size = box.max - box.min;
     const Real radius = 0.5 * size.norm();
-    c.target = 0.5 * (box.min + box.max);
-    const Real fov = 40 * std::numbers::pi / 180;  // horizontal
-    const Real fit = radius / std::sin(0.5 * std::min(fov, fov / aspect * 1.6));
-    c.location = c.target + 1.05 * fit * Vec3(0.45, -1, 0.6).normalized();
+    c.fov = settings.fov;
+    c.target = settings.camera_target.value_or(0.5 * (box.min + box.max));
+    const Real fov = settings.fov * std::numbers::pi / 180;  // horizontal
+    const Real vertical = 2 * std::atan(std::tan(0.5 * fov) / aspect);
+    const Real fit = radius / std::sin(0.5 * std::min(fov, vertical));
+    c.location =
+        settings.camera_position.value_or(c.target + 0.85 * fit * Vec3(0.45, -1, 0.6).normalized());
     c.sun = c.target + radius * Vec3(-3, -4, 8);
     c.ground = box.min.z() - 1e-3 * radius;
     c.scale = std::max(radius / 4, Real(1e-3));
     return c;
 }
 
-std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOptions& options) {
-    const Real aspect = Real(options.width) / options.height;
+std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOptions& options,
+                      Real aspect) {
     std::string pov = "#version 3.7;\nglobal_settings { assumed_gamma 1.0 max_trace_level 10 }\n";
     pov +=
         "sky_sphere { pigment { gradient z color_map { [0 srgb <0.93,0.95,0.98>] [1 srgb "
         "<0.55,0.7,0.9>] } } }\n";
     pov += fmt::format(
-        "camera {{ perspective location {} sky <0,0,1> right <{:.6g},0,0> look_at {} angle 40 "
-        "}}\n",
-        vec(camera.location), -aspect, vec(camera.target));
+        "camera {{ perspective location {} sky <0,0,1> right <{:.6g},0,0> look_at {} angle "
+        "{:.6g} }}\n",
+        vec(camera.location), -aspect, vec(camera.target), camera.fov);
     const Real r = camera.scale;
     if (options.preview)
         pov += fmt::format("light_source {{ {} srgb <1,0.97,0.92> }}\n", vec(camera.sun));
@@ -155,7 +162,39 @@ std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOpti
     return pov;
 }
 
+RenderSettings read_render_settings(const fs::path& file) {
+    RenderSettings s;
+    if (!fs::exists(file)) return s;
+    try {
+        const nlohmann::json j = nlohmann::json::parse(std::ifstream(file));
+        auto point = [&](const char* name) -> std::optional<Vec3> {
+            if (!j.contains(name) || j[name].is_null()) return std::nullopt;
+            return Vec3(j[name][0].get<Real>(), j[name][1].get<Real>(), j[name][2].get<Real>());
+        };
+        s.camera_position = point("camera_position"), s.camera_target = point("camera_target");
+        s.fov = j.at("fov"), s.width = j.at("width"), s.height = j.at("height");
+        s.samples = j.at("samples");
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(fmt::format("cannot read '{}': {}", file.string(), e.what()));
+    }
+    return s;
+}
+
 }  // namespace
+
+std::string render_settings_json(const RenderSettings& s) {
+    auto point = [](const std::optional<Vec3>& p) {
+        return p ? nlohmann::json::array({(*p)[0], (*p)[1], (*p)[2]}) : nlohmann::json();
+    };
+    return nlohmann::json{{"camera_position", point(s.camera_position)},
+                          {"camera_target", point(s.camera_target)},
+                          {"fov", s.fov},
+                          {"width", s.width},
+                          {"height", s.height},
+                          {"samples", s.samples}}
+               .dump(2) +
+           "\n";
+}
 
 RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
     // Frames with a surface, and the box that holds them all.
@@ -175,19 +214,24 @@ RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
             "'{}' has no surface frames (fluid_surface_0000.ply or porous_surface_0000.ply): a "
             "run writes them unless /output/fluid_surface and /output/porous_surface are off",
             dir.string()));
-    const Camera camera = frame_camera(box, Real(options.width) / options.height);
+    const RenderSettings settings = read_render_settings(dir / "render.json");
+    const int width = options.width.value_or(settings.width),
+              height = options.height.value_or(settings.height);
+    const Real aspect = Real(width) / height;
+    const Camera camera = frame_camera(box, settings, aspect);
 
     OutputFolder folder(dir, OutputFolder::Resume{});
     RenderResult result;
     Stopwatch rendering;
     const fs::path pov_file = dir / ".render.pov", png_file = dir / ".render.png";
     for (size_t f = 0; f < frames.size(); ++f) {
-        std::ofstream(pov_file) << pov_scene(frames[f], camera, options);
-        run_tool(fmt::format("povray +I{} +O{} +W{} +H{} +FN -D -V {} {}", quoted(pov_file),
-                             quoted(png_file), options.width, options.height,
-                             options.threads > 0 ? fmt::format("+WT{}", options.threads) : "",
-                             options.preview ? "-A" : "+A0.2 +AM2 +R2"),
-                 "povray");
+        std::ofstream(pov_file) << pov_scene(frames[f], camera, options, aspect);
+        run_tool(
+            fmt::format("povray +I{} +O{} +W{} +H{} +FN -D -V {} {}", quoted(pov_file),
+                        quoted(png_file), width, height,
+                        options.threads > 0 ? fmt::format("+WT{}", options.threads) : "",
+                        options.preview ? "-A" : fmt::format("+A0.2 +AM2 +R{}", settings.samples)),
+            "povray");
         std::ifstream png(png_file, std::ios::binary);
         std::stringstream bytes;
         bytes << png.rdbuf();

@@ -249,6 +249,15 @@ Scene parse_scene(const std::string& text) {
     s.output.level_set = doc["output"]["level_set"];
     s.output.surface_voxel = doc["output"]["surface_voxel"];
     s.output.anisotropic_surface = doc["output"]["anisotropic_surface"];
+    const json& r = doc["render"];
+    if (r.contains("camera_position")) s.render.camera_position = vec3(r["camera_position"]);
+    if (r.contains("camera_target")) s.render.camera_target = vec3(r["camera_target"]);
+    s.render.fov = r["fov"], s.render.width = r["width"], s.render.height = r["height"];
+    s.render.samples = r["samples"];
+    if (s.render.camera_position && s.render.camera_target &&
+        *s.render.camera_position == *s.render.camera_target)
+        throw SceneError("/render/camera_target", "a point other than /render/camera_position",
+                         "the same point");
     s.max_speed = doc["watchdog"]["max_speed"];
     s.sort_interval = doc["numerics"]["sort_interval"];
     s.fingerprint = scene_fingerprint(doc);

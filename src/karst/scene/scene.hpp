@@ -154,6 +154,15 @@ struct FractureSettings {
     Real merge_speed{};         ///< v_merge: largest closing speed of a contact pair, m/s
 };
 
+/// The pictures of `karst render` (render/render.hpp); the camera is framed on the surfaces
+/// where position or target is absent.
+struct RenderSettings {
+    std::optional<Vec3> camera_position, camera_target;  ///< m
+    Real fov = 40;                                       ///< horizontal, degrees
+    int width = 1280, height = 720;                      ///< pixels
+    int samples = 2;  ///< anti-aliasing depth: up to samples^2 rays per pixel
+};
+
 struct OutputSettings {
     Real fps{};
     bool vtp{};
@@ -180,6 +189,7 @@ struct Scene {
     FractureSettings fracture;
     bool paper_eq20{};  ///< /pore_flow/pair_flux: the paper's Eq. 20 instead of M15
     OutputSettings output;
+    RenderSettings render;
     Real max_speed{};  ///< watchdog, m/s
     int sort_interval{};
     /// Hash of the validated scene without /time/end: a checkpoint resumes only the scene it

@@ -398,6 +398,21 @@ std::vector<KeySpec> make_schema() {
             "Yu-Turk anisotropic kernels for the fluid surface: thin sheets and splashes stay "
             "sheets instead of beads, at about twice the meshing time."),
 
+        key("/render", T::Object, "", any(), json::object(),
+            "The pictures of karst render and karst run --render (docs/output_format.md)."),
+        optional("/render/camera_position", T::Vec3, "m", closed(-1e6, 1e6),
+                 "Where the camera stands; absent, it is framed on every frame's surfaces."),
+        optional("/render/camera_target", T::Vec3, "m", closed(-1e6, 1e6),
+                 "The point the camera looks at; absent, the centre of the surfaces' box."),
+        key("/render/fov", T::Number, "deg", closed(1, 170), 40.0, "Horizontal field of view."),
+        key("/render/width", T::Integer, "", closed(16, 7680), 1280,
+            "Frame width in pixels (--width overrides it)."),
+        key("/render/height", T::Integer, "", closed(16, 4320), 720,
+            "Frame height in pixels (--height overrides it)."),
+        key("/render/samples", T::Integer, "", closed(1, 9), 2,
+            "Anti-aliasing depth of the full-quality render: up to samples^2 rays per pixel "
+            "where edges need them (POV-Ray +R); --preview casts one."),
+
         key("/watchdog", T::Object, "", any(), json::object(), "Run-time sanity limits."),
         key("/watchdog/max_speed", T::Number, "m/s", positive(1e6), 100.0,
             "A particle faster than this stops the run (exit code 1)."),

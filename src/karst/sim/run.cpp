@@ -7,6 +7,7 @@
 #include "karst/io/frame_writer.hpp"
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/porous/porous_points.hpp"
+#include "karst/render/render.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/scene/schema.hpp"
 #include "karst/sim/checkpoint.hpp"
@@ -226,6 +227,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
         out.emplace(result.out_dir, scene.output, opt.overwrite);
         out->write_boundary(model.walls);
+        out->folder().write("render.json", render_settings_json(scene.render));
         // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the
         // energy released so far is energy the numerics made; the run says so once.
         record.energy = EnergyAccount(mechanical_energy(model, state));
