@@ -51,12 +51,19 @@ std::string quoted(const fs::path& p) {
     return s + "'";
 }
 
-void run_tool(const std::string& command, const char* tool) {
-    const int status = std::system((command + " > /dev/null 2>&1").c_str());
-    if (status != 0)
-        throw std::runtime_error(
-            fmt::format("{} failed (exit status {}): {}\n(scripts/install_deps.sh installs it)",
-                        tool, status, command));
+/// Runs a tool with its messages in `log`; a failure names the command and the log's last lines.
+void run_tool(const std::string& command, const char* tool, const fs::path& log) {
+    const int status = std::system((command + " > " + quoted(log) + " 2>&1").c_str());
+    if (status == 0) return;
+    std::ifstream in(log);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    std::string tail;
+    for (size_t k = lines.size() > 4 ? lines.size() - 4 : 0; k < lines.size(); ++k)
+        tail += "\n  " + lines[k];
+    throw std::runtime_error(fmt::format(
+        "{} failed (exit status {}): {}{}", tool, status, command,
+        tail.empty() ? "\n(scripts/install_deps.sh installs it)" : tail));
 }
 
 std::string vec(const Vec3& v) {
@@ -141,12 +148,12 @@ std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOpti
         "plane {{ z, {:.6g} texture {{ pigment {{ checker srgb 0.8 srgb 0.7 scale {:.6g} }} "
         "finish {{ diffuse 0.8 }} }} }}\n",
         camera.ground, r);
-    if (frame.porous)
+    if (frame.porous && frame.porous->triangle_count() > 0)
         pov += mesh2(*frame.porous,
                      "pigment {{ srgb <{:.4f},{:.4f},{:.4f}> }} finish {{ diffuse 0.85 "
                      "specular 0.05 }}",
                      "");
-    if (frame.fluid) {
+    if (frame.fluid && frame.fluid->triangle_count() > 0) {
         if (options.preview)
             pov += mesh2(*frame.fluid,
                          "pigment {{ srgbt <{:.4f},{:.4f},{:.4f},0.25> }} finish {{ specular 0.7 "
@@ -223,7 +230,8 @@ RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
     OutputFolder folder(dir, OutputFolder::Resume{});
     RenderResult result;
     Stopwatch rendering;
-    const fs::path pov_file = dir / ".render.pov", png_file = dir / ".render.png";
+    const fs::path pov_file = dir / ".render.pov", png_file = dir / ".render.png",
+                   log_file = dir / ".render.log";
     for (size_t f = 0; f < frames.size(); ++f) {
         std::ofstream(pov_file) << pov_scene(frames[f], camera, options, aspect);
         run_tool(
@@ -231,7 +239,7 @@ RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
                         quoted(png_file), width, height,
                         options.threads > 0 ? fmt::format("+WT{}", options.threads) : "",
                         options.preview ? "-A" : fmt::format("+A0.2 +AM2 +R{}", settings.samples)),
-            "povray");
+            "povray", log_file);
         std::ifstream png(png_file, std::ios::binary);
         std::stringstream bytes;
         bytes << png.rdbuf();
@@ -246,12 +254,12 @@ RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
         fmt::format("ffmpeg -y -loglevel error -framerate {:.6g} -i {} -c:v libx264 "
                     "-pix_fmt yuv420p -movflags +faststart {}",
                     1 / frame_interval(dir), quoted(dir / "render_%04d.png"), quoted(movie_tmp)),
-        "ffmpeg");
+        "ffmpeg", log_file);
     std::ifstream movie(movie_tmp, std::ios::binary);
     std::stringstream bytes;
     bytes << movie.rdbuf();
     folder.write("movie.mp4", bytes.str());
-    fs::remove(movie_tmp);
+    fs::remove(movie_tmp), fs::remove(log_file);
     result.movie = dir / "movie.mp4";
     return result;
 }
