@@ -61,9 +61,9 @@ void run_tool(const std::string& command, const char* tool, const fs::path& log)
     std::string tail;
     for (size_t k = lines.size() > 4 ? lines.size() - 4 : 0; k < lines.size(); ++k)
         tail += "\n  " + lines[k];
-    throw std::runtime_error(fmt::format(
-        "{} failed (exit status {}): {}{}", tool, status, command,
-        tail.empty() ? "\n(scripts/install_deps.sh installs it)" : tail));
+    throw std::runtime_error(
+        fmt::format("{} failed (exit status {}): {}{}", tool, status, command,
+                    tail.empty() ? "\n(scripts/install_deps.sh installs it)" : tail));
 }
 
 std::string vec(const Vec3& v) {
