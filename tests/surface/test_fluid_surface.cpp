@@ -2,10 +2,11 @@
 // and volume, a resting tank to its water level, every mesh is closed, manifold and free of
 // self-intersections, the same bits on 1 and 2 threads, and the anisotropic kernels keep a sheet
 // one particle thick whole where the isotropic ones bead it.
+#include "support/surfaces.hpp"
+
 #include "karst/core/disjoint_sets.hpp"
 #include "karst/core/parallel.hpp"
 #include "karst/surface/fluid_surface.hpp"
-#include "karst/surface/mesh_repair.hpp"
 
 #include <gtest/gtest.h>
 
@@ -52,13 +53,6 @@ Index components(const SurfaceMesh& mesh) {
     return n;
 }
 
-void expect_clean(const SurfaceMesh& mesh) {
-    const SurfaceCheck check = check_surface(mesh);
-    EXPECT_TRUE(check.closed_manifold);
-    EXPECT_EQ(check.self_intersections, 0);
-    EXPECT_EQ(check.degenerate, 0);
-}
-
 TEST(FluidSurface, ABallOfRadiusTenSpacingsMeshesToItsSphere) {
     const Real radius = 10 * dx;
     const Particles p = ball(radius);
@@ -70,7 +64,7 @@ TEST(FluidSurface, ABallOfRadiusTenSpacingsMeshesToItsSphere) {
     EXPECT_NEAR(m.area / area, 1, 0.03);
     EXPECT_NEAR(m.volume / volume, 1, 0.03);
     EXPECT_EQ(components(mesh), 1);
-    expect_clean(mesh);
+    test::expect_clean(mesh);
 }
 
 TEST(FluidSurface, ARestingTanksSurfaceLiesAtTheWaterLevel) {
@@ -90,7 +84,7 @@ TEST(FluidSurface, ARestingTanksSurfaceLiesAtTheWaterLevel) {
     EXPECT_GT(top, 100);
     std::printf("tank worst %.4f dx\n", worst / dx);
     EXPECT_LT(worst, dx / 4);
-    expect_clean(mesh);
+    test::expect_clean(mesh);
 }
 
 /// A ball of water with its particles jittered by 0.3 dx and a splash of loose drops.
@@ -119,7 +113,7 @@ TEST(FluidSurface, AJitteredSplashIsClosedManifoldAndTheSameOnOneAndTwoThreads) 
         ASSERT_GT(one.triangle_count(), 1000);
         EXPECT_EQ(one.triangles, two.triangles);
         EXPECT_EQ(one.vertices.x, two.vertices.x);
-        expect_clean(one);
+        test::expect_clean(one);
     }
 }
 
@@ -133,7 +127,7 @@ TEST(FluidSurface, AnisotropicKernelsKeepAThinSheetWholeWhereIsotropicOnesBeadIt
     // Isotropic kernels leave beads or nothing: a colour below 1/2 between the particles.
     EXPECT_NE(components(isotropic), 1);
     EXPECT_EQ(components(anisotropic), 1);
-    expect_clean(anisotropic);
+    test::expect_clean(anisotropic);
     // The anisotropic sheet keeps its extent: its two sides span the particles' plane.
     const Real side = 23 * 1.3 * dx;
     const Real area = surface_measures(anisotropic).area;

@@ -2,8 +2,8 @@
 // particles, closed, manifold and free of self-intersections even where two pieces touch along
 // an edge, darker where wet (M29), following its particles and rebuilt when members go.
 #include "support/simulate.hpp"
+#include "support/surfaces.hpp"
 
-#include "karst/surface/mesh_repair.hpp"
 #include "karst/surface/porous_surface.hpp"
 
 #include <fmt/format.h>
@@ -27,13 +27,6 @@ std::string boxes(const std::vector<std::pair<Vec3, Vec3>>& corners) {
         solids);
 }
 
-void expect_clean(const SurfaceMesh& mesh) {
-    const SurfaceCheck check = check_surface(mesh);
-    EXPECT_TRUE(check.closed_manifold);
-    EXPECT_EQ(check.self_intersections, 0);
-    EXPECT_EQ(check.degenerate, 0);
-}
-
 TEST(PorousSurface, ABlocksSurfaceIsItsAlphaShapeAndDarkerWhereWet) {
     test::Simulation sim(boxes({{Vec3(0, 0, 0), Vec3(0.2, 0.2, 0.1)}}));
     const PorousParticles& p = sim.state.porous.particles;
@@ -41,7 +34,7 @@ TEST(PorousSurface, ABlocksSurfaceIsItsAlphaShapeAndDarkerWhereWet) {
     for (Index i = 0; i < p.size(); ++i) saturation[i] = p.x[i].x() < 0.1 ? 0 : 1;
     PorousSurfaces surfaces;
     const SurfaceMesh mesh = surfaces.build(sim.model, p, saturation);
-    expect_clean(mesh);
+    test::expect_clean(mesh);
     // The lattice's hull: sites from dx/2 to the far side less dx/2.
     const SurfaceMeasures m = surface_measures(mesh);
     EXPECT_NEAR(m.volume, 0.18 * 0.18 * 0.08, 1e-9);
@@ -91,7 +84,7 @@ TEST(PorousSurface, TwoBlocksMeetingAtAnEdgeMakeAManifoldSurface) {
                 p.x[i] + (p.fragment[i] == 0 ? Vec3::Zero() : Vec3(offset, 0, 0));
         const SurfaceMesh mesh = surfaces.build(sim.model, one, std::vector<Real>(one.size(), 0));
         SCOPED_TRACE(offset);
-        expect_clean(mesh);
+        test::expect_clean(mesh);
     }
 }
 
@@ -119,7 +112,7 @@ TEST(PorousSurface, FollowsItsParticlesAndIsRebuiltWhenMembersGo) {
         p.id.erase(p.id.begin() + corner), p.porosity.erase(p.porosity.begin() + corner),
         p.rest.erase(p.rest.begin() + corner);
     const SurfaceMesh after = surfaces.build(sim.model, p, std::vector<Real>(p.size(), 0));
-    expect_clean(after);
+    test::expect_clean(after);
     for (const Vec3& x : after.vertices.x) EXPECT_GT((x - gone).norm(), 1e-9);
     EXPECT_LT(surface_measures(after).volume, surface_measures(moved).volume);
 }

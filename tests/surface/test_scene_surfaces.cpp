@@ -3,23 +3,15 @@
 // dissolves.
 #include "support/files.hpp"
 #include "support/simulate.hpp"
+#include "support/surfaces.hpp"
 
 #include "karst/surface/fluid_frame.hpp"
-#include "karst/surface/mesh_repair.hpp"
 #include "karst/surface/porous_surface.hpp"
 
 #include <gtest/gtest.h>
 
 namespace karst {
 namespace {
-
-void expect_clean(const SurfaceMesh& mesh, const char* what) {
-    SCOPED_TRACE(what);
-    const SurfaceCheck check = check_surface(mesh);
-    EXPECT_TRUE(check.closed_manifold);
-    EXPECT_EQ(check.self_intersections, 0);
-    EXPECT_EQ(check.degenerate, 0);
-}
 
 void check_scene(const std::string& file, std::vector<Real> times, bool anisotropic) {
     SCOPED_TRACE(file);
@@ -30,7 +22,10 @@ void check_scene(const std::string& file, std::vector<Real> times, bool anisotro
         sim.run_until(t);
         const SurfaceMesh fluid = fluid_frame_surface(sim.model, sim.state.fluid);
         ASSERT_GT(fluid.triangle_count(), 100);
-        expect_clean(fluid, "fluid");
+        {
+            SCOPED_TRACE("fluid");
+            test::expect_clean(fluid);
+        }
         // The colour follows the concentration: clear water is the lightest (M29).
         for (Index v = 0; v < fluid.vertex_count(); ++v)
             ASSERT_EQ(fluid.colour[v], m29_colour(fluid.vertices.arrays[2].values[v], k_water_hue,
@@ -42,7 +37,10 @@ void check_scene(const std::string& file, std::vector<Real> times, bool anisotro
             saturation[i] = p.absorbed_mass[i] / (sim.model.rho0 * p.porosity[i] * p.volume[i]);
         const SurfaceMesh rock = porous.build(sim.model, p, saturation);
         ASSERT_GT(rock.triangle_count(), 100);
-        expect_clean(rock, "porous");
+        {
+            SCOPED_TRACE("porous");
+            test::expect_clean(rock);
+        }
     }
 }
 
