@@ -14,7 +14,7 @@ namespace karst {
 void split_non_manifold(std::vector<Vec3>& x, std::vector<std::array<Index, 3>>& triangles,
                         std::vector<Index>& source);
 
-/// What a surface is, as the tests and `karst` check it.
+/// What a surface is, as the surface tests check it.
 struct SurfaceCheck {
     bool closed_manifold = false;  ///< every edge in exactly two faces, of opposite directions,
                                    ///< and every vertex's faces one fan
