@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include <csignal>
@@ -77,7 +79,7 @@ nlohmann::json stats_without_timings(const fs::path& dir) {
 
 /// Every frame file of `a` is in `b` with the same bytes and `b` has no other; stats agree.
 void expect_same_run(const fs::path& a, const fs::path& b) {
-    for (const char* kind : {".vtp", ".vtu"}) {
+    for (const char* kind : {".vtp", ".geo", ".ens", ".case"}) {
         const std::set<std::string> names = files_ending(a, kind);
         EXPECT_EQ(names, files_ending(b, kind)) << kind;
         for (const std::string& name : names)
@@ -121,6 +123,11 @@ TEST(Checkpoint, AResumedRunThatCracksAndSplitsNodesContinuesBitForBit) {
         0);
     const auto stats = nlohmann::json::parse(read_text(straight / "stats.json"));
     ASSERT_GT(stats["fracture"]["nodes_split"].get<int>(), 0);
+    // Split nodes change the mesh: a new geometry file, and frames that read an older one.
+    const std::set<std::string> geometries = files_ending(straight, ".geo");
+    EXPECT_GT(geometries.size(), 1u);
+    const std::string log = read_text(straight / "log.csv");
+    EXPECT_LT(geometries.size(), size_t(std::count(log.begin(), log.end(), '\n') - 1));
     fs::copy(straight, resumed, fs::copy_options::recursive);
     forget_checkpoints_after(resumed, 1);  // at 0.05 s, with cracks to come
     ASSERT_EQ(karst("run " + box.scene() + " --quiet --resume " + resumed.string()), 0);

@@ -153,25 +153,29 @@ TEST(PoroelasticScene, BadPorousScenesAreRefusedWithTheirPath) {
     EXPECT_NE(overlap.found.find("/fluid_blocks/0"), std::string::npos);
 }
 
-TEST(PoroelasticScene, CliWritesMeshFramesListedInRunPvdAndStats) {
+TEST(PoroelasticScene, CliWritesMeshFramesListedInMeshCaseAndStats) {
     const std::filesystem::path out =
         std::filesystem::temp_directory_path() / "karst_test_poroelastic";
     std::filesystem::remove_all(out);
     const std::string command = std::string(KARST_BINARY) + " run " + k_scene +
                                 " --end-time 0.2 --fps 10 --quiet --out " + out.string();
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
-    for (int f = 0; f < 3; ++f)
-        EXPECT_TRUE(std::filesystem::exists(out / fmt::format("mesh_{:04d}.vtu", f))) << f;
-    EXPECT_FALSE(std::filesystem::exists(out / "mesh_0003.vtu"));
-    const std::string pvd = read_text(out / "run.pvd");
-    for (int f = 0; f < 3; ++f)
-        EXPECT_NE(pvd.find(fmt::format("part=\"2\" file=\"mesh_{:04d}.vtu\"", f)),
-                  std::string::npos);
-    const std::string vtu = read_text(out / "mesh_0002.vtu");
+    // The mesh's geometry is written once (it never changes here), its arrays every frame.
+    EXPECT_TRUE(std::filesystem::exists(out / "mesh_0000.geo"));
+    EXPECT_FALSE(std::filesystem::exists(out / "mesh_0001.geo"));
+    EXPECT_FALSE(std::filesystem::exists(out / "mesh_pore_pressure_0003.ens"));
+    const std::string mesh_case = read_text(out / "mesh.case");
+    EXPECT_NE(mesh_case.find("number of steps: 3\nfilename numbers:\n0 0 0\n"), std::string::npos)
+        << mesh_case;
     for (const char* array : {"displacement", "pore_pressure", "porosity", "permeability",
-                              "effective_stress", "principal_stress", "crack_candidate"})
-        EXPECT_NE(vtu.find(fmt::format("Name=\"{}\"", array)), std::string::npos) << array;
-    EXPECT_NE(vtu.find("Name=\"types\""), std::string::npos);
+                              "effective_stress", "principal_stress", "crack_candidate"}) {
+        EXPECT_NE(mesh_case.find(fmt::format(" {} mesh_{}_****.ens", array, array)),
+                  std::string::npos)
+            << array;
+        EXPECT_TRUE(std::filesystem::exists(out / fmt::format("mesh_{}_0000.ens", array)));
+    }
+    EXPECT_TRUE(std::filesystem::exists(out / "mesh_pore_pressure_0002.ens"));
+    const std::string pvd = read_text(out / "run.pvd");
     EXPECT_NE(pvd.find("part=\"3\" file=\"porous_0002.vtp\""), std::string::npos);
     const std::string vtp = read_text(out / "porous_0002.vtp");
     for (const char* array : {"saturation", "porosity", "absorbed_mass", "pore_pressure",

@@ -1,5 +1,7 @@
 #include "karst/io/frame_writer.hpp"
 
+#include "karst/core/fnv1a.hpp"
+#include "karst/io/ensight_writer.hpp"
 #include "karst/io/ply_writer.hpp"
 #include "karst/io/vtk_writer.hpp"
 
@@ -30,7 +32,8 @@ FrameWriter::FrameWriter(fs::path dir, const OutputSettings& settings, FrameHist
         if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
             return false;
         const std::string ext = name.substr(dot);
-        return (ext == ".vtp" || ext == ".vtu" || ext == ".ply" || ext == ".vdb") &&
+        return (ext == ".vtp" || ext == ".ply" || ext == ".vdb" || ext == ".geo" ||
+                ext == ".ens") &&
                std::stoll(digits) >= kept;
     });
 }
@@ -46,7 +49,7 @@ void FrameWriter::write_boundary(const WallParticles& walls) {
 void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
     const int frame = frames();
     const bool fluid_part = parts.fluid && (m_settings.vtp || m_settings.ply);
-    const bool mesh = parts.mesh && m_settings.mesh;
+    const bool mesh = parts.mesh && !parts.mesh->nodes.x.empty() && m_settings.mesh;
     const bool porous = parts.porous && m_settings.porous;
     const bool cracks = parts.cracks && !parts.cracks->polygons.empty() && m_settings.cracks;
     if (fluid_part) {
@@ -73,9 +76,8 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         if (m_settings.ply)
             m_folder.write(fmt::format("fluid_{:04d}.ply", frame), ply_bytes(points));
     }
-    if (mesh)
-        m_folder.write(fmt::format("mesh_{:04d}.vtu", frame),
-                       vtu_bytes(parts.mesh->nodes, parts.mesh->tets, m_settings.compress));
+    std::vector<int> mesh_files;
+    if (mesh) mesh_files = write_mesh(*parts.mesh, frame, log.time);
     m_history.log.push_back(log);
     if (porous)
         m_folder.write(fmt::format("porous_{:04d}.vtp", frame),
@@ -92,23 +94,21 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
         write_surface(fmt::format("porous_surface_{:04d}", frame), *parts.porous_surface);
     if (parts.level_set && m_settings.level_set)
         m_folder.write(fmt::format("fluid_level_set_{:04d}.vdb", frame), *parts.level_set);
-    m_history.written.push_back(
-        {fluid_part && m_settings.vtp, mesh, porous, cracks, fluid_surface, porous_surface});
+    m_history.written.push_back({fluid_part && m_settings.vtp, mesh, porous, cracks, fluid_surface,
+                                 porous_surface, std::move(mesh_files)});
     const std::vector<FrameLog>& rows = m_history.log;
     const std::vector<FrameHistory::Written>& written = m_history.written;
     const bool boundary = m_history.has_boundary;
 
-    if (boundary || m_settings.vtp || m_settings.mesh || m_settings.porous || m_settings.cracks ||
+    if (boundary || m_settings.vtp || m_settings.porous || m_settings.cracks ||
         m_settings.fluid_surface || m_settings.porous_surface) {
-        // Parts: 0 fluid, 1 boundary, 2 mesh, 3 porous particles, 4 cracks, 5 fluid surface,
-        // 6 porous surface.
+        // Parts: 0 fluid, 1 boundary, 3 porous particles, 4 cracks, 5 fluid surface, 6 porous
+        // surface (2, the mesh, is in mesh.case).
         std::vector<PvdEntry> entries;
         for (int f = 0; f < frames(); ++f) {
             if (written[f].fluid)
                 entries.push_back({rows[f].time, 0, fmt::format("fluid_{:04d}.vtp", f)});
             if (boundary) entries.push_back({rows[f].time, 1, "boundary.vtp"});
-            if (written[f].mesh)
-                entries.push_back({rows[f].time, 2, fmt::format("mesh_{:04d}.vtu", f)});
             if (written[f].porous)
                 entries.push_back({rows[f].time, 3, fmt::format("porous_{:04d}.vtp", f)});
             if (written[f].cracks)
@@ -132,6 +132,41 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
             r.kinetic_energy + r.potential_energy);
     }
     m_folder.write("log.csv", csv);
+}
+
+std::vector<int> FrameWriter::write_mesh(const MeshFrame& mesh, int frame, Real time) {
+    // File 0 is the geometry (rest positions and tetrahedra: it changes only when a mesh is
+    // rebuilt, split or merged), file k the k-th array. Each is written when its bytes differ
+    // from its newest file's, which the frame otherwise reads again.
+    std::vector<std::string> names{ensight_file("mesh", "", frame)};
+    std::vector<std::string> bytes{ensight_geometry_bytes(mesh.nodes, mesh.tets)};
+    for (const PointArray& array : mesh.nodes.arrays) {
+        names.push_back(ensight_file("mesh", array.name, frame));
+        bytes.push_back(ensight_variable_bytes(mesh.nodes, array));
+    }
+    const std::vector<int>* previous = nullptr;
+    for (const FrameHistory::Written& w : m_history.written)
+        if (w.mesh) previous = &w.mesh_files;
+    std::vector<std::uint64_t>& hashes = m_history.mesh_hashes;
+    const bool same_layout = previous && previous->size() == bytes.size();
+    if (!same_layout) hashes.assign(bytes.size(), 0);
+    std::vector<int> files(bytes.size());
+    for (size_t k = 0; k < bytes.size(); ++k) {
+        const std::uint64_t hash = fnv1a(bytes[k]);
+        if (same_layout && hash == hashes[k]) {
+            files[k] = (*previous)[k];
+            continue;
+        }
+        m_folder.write(names[k], bytes[k]);
+        hashes[k] = hash, files[k] = frame;
+    }
+    std::vector<EnsightStep> steps;
+    for (int f = 0; f < frames(); ++f)
+        if (m_history.written[f].mesh && m_history.written[f].mesh_files.size() == files.size())
+            steps.push_back({m_history.log[f].time, m_history.written[f].mesh_files});
+    steps.push_back({time, files});
+    m_folder.write("mesh.case", ensight_case_bytes("mesh", mesh.nodes, steps));
+    return files;
 }
 
 CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {

@@ -1,7 +1,7 @@
 #pragma once
 // The output folder of a run: per-frame fluid and mesh files, the static boundary, run.pvd,
-// log.csv and stats.json. Each file is written atomically; run.pvd and log.csv are rewritten after
-// every frame, so the folder is complete and consistent whenever a run stops.
+// mesh.case, log.csv and stats.json. Each file is written atomically; run.pvd and log.csv are
+// rewritten after every frame, so the folder is complete and consistent whenever a run stops.
 #include "karst/io/output_folder.hpp"
 #include "karst/io/point_arrays.hpp"
 #include "karst/scene/scene.hpp"
@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -64,10 +65,14 @@ struct FrameHistory {
     struct Written {
         bool fluid = false, mesh = false, porous = false, cracks = false;
         bool fluid_surface = false, porous_surface = false;
+        /// The frames whose files this frame's mesh reads: its geometry, then each array (a
+        /// file is written only when its bytes changed).
+        std::vector<int> mesh_files;
     };
     std::vector<FrameLog> log;
     std::vector<Written> written;  ///< which parts each frame has
     bool has_boundary = false;
+    std::vector<std::uint64_t> mesh_hashes;  ///< FNV-1a of the newest of each of those files
 };
 
 class FrameWriter {
@@ -79,9 +84,10 @@ public:
     /// frame files it wrote after them are removed, the rest is kept.
     FrameWriter(std::filesystem::path dir, const OutputSettings& settings, FrameHistory history);
     void write_boundary(const WallParticles& walls);
-    /// fluid_NNNN.vtp/.ply, mesh_NNNN.vtu, porous_NNNN.vtp, cracks_NNNN.vtp,
+    /// fluid_NNNN.vtp/.ply, the mesh (mesh_NNNN.geo and mesh_<array>_NNNN.ens, each only when
+    /// it changed), porous_NNNN.vtp, cracks_NNNN.vtp,
     /// fluid_surface_NNNN.ply/.vtp, porous_surface_NNNN.ply/.vtp and fluid_level_set_NNNN.vdb as
-    /// present, then run.pvd and log.csv anew.
+    /// present, then run.pvd, mesh.case and log.csv anew.
     void write_frame(const FrameParts& parts, const FrameLog& log);
     void write_stats(const nlohmann::json& stats);
     int frames() const { return int(m_history.log.size()); }
@@ -90,6 +96,9 @@ public:
     const std::filesystem::path& dir() const { return m_folder.dir(); }
 
 private:
+    /// The mesh's files of frame `frame` at `time` that changed, and mesh.case; returns the
+    /// frames whose files it reads.
+    std::vector<int> write_mesh(const MeshFrame& mesh, int frame, Real time);
     /// <stem>.ply and <stem>.vtp of a surface.
     void write_surface(const std::string& stem, const SurfaceMesh& mesh);
     OutputFolder m_folder;

@@ -170,47 +170,6 @@ std::string vtp_polygons_bytes(const PointSet& points,
     return polydata_bytes(points, "Polys", conn, offsets, zlib);
 }
 
-std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets,
-                      bool zlib) {
-    std::string blob;
-    const auto [point_data, points_offset] = append_points(blob, points, zlib);
-    const size_t conn_offset = blob.size();
-    std::vector<std::int64_t> conn, offsets;
-    conn.reserve(4 * tets.size()), offsets.reserve(tets.size());
-    for (const auto& t : tets) {
-        conn.insert(conn.end(), {t[0], t[1], t[2], t[3]});
-        offsets.push_back(std::int64_t(conn.size()));
-    }
-    append_block(blob, conn, zlib);
-    const size_t offsets_offset = blob.size();
-    append_block(blob, offsets, zlib);
-    const size_t types_offset = blob.size();
-    append_block(blob, std::vector<std::uint8_t>(tets.size(), 10), zlib);  // VTK_TETRA
-    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
-                              "{7}"
-                              "  <UnstructuredGrid>\n"
-                              "    <Piece NumberOfPoints=\"{0}\" NumberOfCells=\"{1}\">\n"
-                              "      <PointData>\n{2}      </PointData>\n"
-                              "      <Points>\n"
-                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
-                              "format=\"appended\" offset=\"{3}\"/>\n"
-                              "      </Points>\n"
-                              "      <Cells>\n"
-                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
-                              "format=\"appended\" offset=\"{4}\"/>\n"
-                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
-                              "format=\"appended\" offset=\"{5}\"/>\n"
-                              "        <DataArray type=\"UInt8\" Name=\"types\" "
-                              "format=\"appended\" offset=\"{6}\"/>\n"
-                              "      </Cells>\n"
-                              "    </Piece>\n"
-                              "  </UnstructuredGrid>\n"
-                              "  <AppendedData encoding=\"raw\">\n   _",
-                              points.x.size(), tets.size(), point_data, points_offset, conn_offset,
-                              offsets_offset, types_offset, vtk_file_tag("UnstructuredGrid", zlib)),
-                  blob);
-}
-
 std::string pvd_bytes(const std::vector<PvdEntry>& entries) {
     std::string out =
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "

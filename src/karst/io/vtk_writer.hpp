@@ -1,7 +1,6 @@
 #pragma once
 #include "karst/io/point_arrays.hpp"
 
-#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -17,11 +16,6 @@ std::string vtp_bytes(const PointSet& points, bool zlib = true);
 /// the point arrays.
 std::string vtp_polygons_bytes(const PointSet& points,
                                const std::vector<std::vector<Index>>& polygons, bool zlib = true);
-
-/// VTK XML UnstructuredGrid (.vtu) of tetrahedra, appended binary as vtp_bytes, with the point
-/// arrays.
-std::string vtu_bytes(const PointSet& points, const std::vector<std::array<Index, 4>>& tets,
-                      bool zlib = true);
 
 /// One data set of a ParaView collection (.pvd).
 struct PvdEntry {

@@ -1,3 +1,4 @@
+#include "karst/core/fnv1a.hpp"
 #include "karst/scene/scene.hpp"
 #include "karst/scene/read_json.hpp"
 #include "karst/scene/scene_error.hpp"
@@ -24,9 +25,7 @@ using json = nlohmann::json;
 /// resumed run may extend.
 std::uint64_t scene_fingerprint(json doc) {
     doc["time"].erase("end");
-    std::uint64_t hash = 14695981039346656037ull;
-    for (const unsigned char c : doc.dump()) hash = (hash ^ c) * 1099511628211ull;
-    return hash;
+    return fnv1a(doc.dump());
 }
 
 /// Scenes are hand-written or generated descriptions, never data: 64 MB is far beyond any.

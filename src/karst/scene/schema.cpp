@@ -373,7 +373,8 @@ std::vector<KeySpec> make_schema() {
         key("/output/porous", T::Bool, "", any(), true,
             "Write the porous particles, porous_NNNN.vtp."),
         key("/output/mesh", T::Bool, "", any(), true,
-            "Write the PFEM meshes with their Biot fields, mesh_NNNN.vtu."),
+            "Write the PFEM meshes with their Biot fields: mesh.case (EnSight Gold) and its "
+            "files."),
         key("/output/walls", T::Bool, "", any(), true,
             "Write the wall particles once, boundary.vtp."),
         key("/output/cracks", T::Bool, "", any(), true,

@@ -1,5 +1,6 @@
 #include "karst/sim/checkpoint.hpp"
 
+#include "karst/core/fnv1a.hpp"
 #include "karst/io/binary_archive.hpp"
 #include "karst/scene/scene_error.hpp"
 
@@ -106,12 +107,12 @@ void fields(Ar& ar, FrameLog& l) {
 
 template <class Ar>
 void fields(Ar& ar, FrameHistory::Written& w) {
-    ar(w.fluid, w.mesh, w.porous, w.cracks, w.fluid_surface, w.porous_surface);
+    ar(w.fluid, w.mesh, w.porous, w.cracks, w.fluid_surface, w.porous_surface, w.mesh_files);
 }
 
 template <class Ar>
 void fields(Ar& ar, FrameHistory& h) {
-    ar(h.log, h.written, h.has_boundary);
+    ar(h.log, h.written, h.has_boundary, h.mesh_hashes);
 }
 
 template <class Ar>
@@ -135,12 +136,6 @@ namespace {
 
 constexpr char k_magic[] = "karst checkpoint";
 
-std::uint64_t checksum(std::string_view bytes) {
-    std::uint64_t hash = 14695981039346656037ull;  // FNV-1a
-    for (const unsigned char c : bytes) hash = (hash ^ c) * 1099511628211ull;
-    return hash;
-}
-
 }  // namespace
 
 std::string checkpoint_bytes(const CheckpointKey& key, const State& state,
@@ -149,7 +144,7 @@ std::string checkpoint_bytes(const CheckpointKey& key, const State& state,
     body(state, record);
     ArchiveWriter file;
     file(std::string(k_magic), k_checkpoint_format, std::string(KARST_VERSION), key.scene, key.fps,
-         body.bytes(), checksum(body.bytes()));
+         body.bytes(), fnv1a(body.bytes()));
     return file.bytes();
 }
 
@@ -186,7 +181,7 @@ void read_checkpoint(const std::filesystem::path& path, const CheckpointKey& key
             throw refuse(fmt::format("a checkpoint written at {:g} frames per second", key.fps),
                          fmt::format("one at {:g}", found.fps));
         file(body, sum);
-        if (sum != checksum(body) || file.left() != 0)
+        if (sum != fnv1a(body) || file.left() != 0)
             throw refuse("an intact checkpoint", "a damaged one (checksum)");
         ArchiveReader reader(body);
         reader(state, record);
