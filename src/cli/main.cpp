@@ -55,8 +55,8 @@ int main(int argc, char** argv) {
     bool render_after = false;
     karst::RenderOptions render_options;
     run->add_flag("--render", render_after,
-                  "Render the run's surfaces to PNG frames and movie.mp4 when it ends (as "
-                  "karst render)");
+                  "Render each frame's surfaces to a PNG as the run goes (POV-Ray, beside the "
+                  "simulation) and movie.mp4 at its end; the camera frames the domain");
     std::string render_dir;
     CLI::App* render = app.add_subcommand(
         "render", "Render a run's surfaces to render_NNNN.png and movie.mp4 (POV-Ray, ffmpeg)");
@@ -119,6 +119,10 @@ int main(int argc, char** argv) {
         run_options.end_time = end_time, run_options.fps = fps;
         run_options.checkpoint_every = checkpoint_every;
         if (!resume_dir.empty()) run_options.resume = resume_dir;
+        if (render_after) {
+            render_options.threads = run_options.threads;
+            run_options.render = render_options;
+        }
         karst::catch_stop_signals();
         const karst::RunResult result = karst::run_simulation(read_scene(scene_path), run_options);
         if (result.stop_signal) {
@@ -139,13 +143,10 @@ int main(int argc, char** argv) {
                        result.stats["frames"].get<int>(), result.out_dir.string(),
                        result.stats["wall_time"].get<double>(),
                        result.stats["mipps"].get<double>());
-        if (render_after) {
-            render_options.threads = run_options.threads;
-            const karst::RenderResult r = karst::render_run(result.out_dir, render_options);
-            if (!run_options.quiet)
-                fmt::print(stderr, "karst: rendered {} frames ({:.2f} s each) and {}\n", r.frames,
-                           r.seconds_per_frame, r.movie.string());
-        }
+        if (result.render && !run_options.quiet)
+            fmt::print(stderr, "karst: rendered {} frames ({:.2f} s each) and {}\n",
+                       result.render->frames, result.render->seconds_per_frame,
+                       result.render->movie.string());
         return 0;
     } catch (const karst::SceneError& e) {
         fmt::print(stderr, "karst: {}\n", e.what());

@@ -1,5 +1,6 @@
 // `karst render` (issue 14): a cave_soak run renders to one PNG per frame and an MP4 whose frame
-// count ffprobe confirms, and a frame shows water and rock, not a blank picture.
+// count ffprobe confirms, and a frame shows water and rock, not a blank picture; `karst run
+// --render` makes its pictures while the run goes on.
 #include "support/files.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 
@@ -39,7 +41,10 @@ TEST(Render, TheCaveSoakRendersAFramePerSurfaceAndAMovie) {
     const std::string karst = KARST_BINARY;
     ASSERT_EQ(test::exit_code_of(karst + " run " + KARST_SOURCE_DIR +
                                  "/scenes/cave_soak.json --quiet --end-time 0.1 --fps 20 --out " +
-                                 out.string() + " --render --preview --width 320 --height 180"),
+                                 out.string()),
+              0);
+    ASSERT_EQ(test::exit_code_of(karst + " render " + out.string() +
+                                 " --preview --width 320 --height 180"),
               0);
     int pngs = 0;
     for (const auto& e : fs::directory_iterator(out)) pngs += e.path().extension() == ".png";
@@ -67,6 +72,34 @@ TEST(Render, TheCaveSoakRendersAFramePerSurfaceAndAMovie) {
     const std::string manifest = test::read_text(out / "manifest.txt");
     EXPECT_NE(manifest.find("render_0002.png"), std::string::npos);
     EXPECT_NE(manifest.find("movie.mp4"), std::string::npos);
+}
+
+TEST(Render, ARunRendersItsFramesAsItGoes) {
+    for (const char* tool : {"povray", "ffmpeg"})
+        if (!on_path(tool))
+            GTEST_SKIP() << tool << " is not installed (scripts/install_deps.sh installs it)";
+    // The built-in dam break with an end far away, stopped once its second picture is out: the
+    // pictures came during the run, and the stopped run still ends with every frame's picture
+    // and the movie.
+    const test::TempDir dir("render_live");
+    const fs::path out = dir.path / "out";
+    const std::string picture = (out / "render_0001.png").string();
+    std::string command = fmt::format(
+        "({} run --quiet --end-time 20 --fps 20 --render --preview --width 160 --height 90 "
+        "--out {} & pid=$!; while [ ! -f {} ]; do sleep 0.05; done; kill -TERM $pid; wait $pid)",
+        KARST_BINARY, out.string(), picture);
+    std::string err;
+    EXPECT_EQ(test::exit_code_of(command, &err), 128 + SIGTERM) << err;
+    const nlohmann::json stats = nlohmann::json::parse(test::read_text(out / "stats.json"));
+    const int frames = stats["frames"];
+    EXPECT_GE(frames, 2);
+    EXPECT_LT(stats["sim_time"].get<double>(), 20);
+    for (int f = 0; f < frames; ++f)
+        EXPECT_TRUE(fs::exists(out / fmt::format("render_{:04d}.png", f))) << f;
+    EXPECT_FALSE(fs::exists(out / fmt::format("render_{:04d}.png", frames)));
+    EXPECT_TRUE(fs::exists(out / "movie.mp4"));
+    for (const auto& e : fs::directory_iterator(out))
+        EXPECT_NE(e.path().filename().string()[0], '.') << e.path();  // no scratch file left
 }
 
 TEST(Render, AFolderWithoutSurfacesIsRefusedWithTheReason) {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <future>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -99,11 +100,6 @@ std::string mesh2(const SurfaceMesh& mesh, const std::string& material, const ch
                            texture[t[2]]);
     return out + fmt::format(" }}\n {}\n}}\n", interior);
 }
-
-struct Camera {
-    Vec3 location, target, sun;
-    Real ground = 0, scale = 1, fov = 40;
-};
 
 /// The camera of `settings`, its missing parts framed on `box`: seen from the front left and
 /// above, at 0.85 of the distance at which the box's bounding sphere fills the narrower field of
@@ -203,64 +199,172 @@ std::string render_settings_json(const RenderSettings& s) {
            "\n";
 }
 
-RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
-    // Frames with a surface, and the box that holds them all.
-    std::vector<Frame> frames;
-    Aabb box;
-    for (int f = 0;; ++f) {
-        Frame frame{read_if_present(dir / fmt::format("fluid_surface_{:04d}.ply", f)),
-                    read_if_present(dir / fmt::format("porous_surface_{:04d}.ply", f))};
-        if (!frame.fluid && !frame.porous) break;
-        for (const auto* m : {&frame.fluid, &frame.porous})
-            if (*m)
-                for (const Vec3& x : (*m)->vertices.x) box.extend(x);
-        frames.push_back(std::move(frame));
-    }
-    if (frames.empty() || box.min.x() > box.max.x())
-        throw std::runtime_error(fmt::format(
-            "'{}' has no surface frames (fluid_surface_0000.ply or porous_surface_0000.ply): a "
-            "run writes them unless /output/fluid_surface and /output/porous_surface are off",
-            dir.string()));
-    const RenderSettings settings = read_render_settings(dir / "render.json");
-    const int width = options.width.value_or(settings.width),
-              height = options.height.value_or(settings.height);
-    const Real aspect = Real(width) / height;
-    const Camera camera = frame_camera(box, settings, aspect);
+namespace {
 
-    OutputFolder folder(dir, OutputFolder::Resume{});
-    RenderResult result;
-    Stopwatch rendering;
-    const fs::path pov_file = dir / ".render.pov", png_file = dir / ".render.png",
-                   log_file = dir / ".render.log";
-    for (size_t f = 0; f < frames.size(); ++f) {
-        std::ofstream(pov_file) << pov_scene(frames[f], camera, options, aspect);
-        run_tool(
-            fmt::format("povray +I{} +O{} +W{} +H{} +FN -D -V {} {}", quoted(pov_file),
-                        quoted(png_file), width, height,
-                        options.threads > 0 ? fmt::format("+WT{}", options.threads) : "",
-                        options.preview ? "-A" : fmt::format("+A0.2 +AM2 +R{}", settings.samples)),
-            "povray", log_file);
-        std::ifstream png(png_file, std::ios::binary);
-        std::stringstream bytes;
-        bytes << png.rdbuf();
-        folder.write(fmt::format("render_{:04d}.png", f), bytes.str());
-    }
-    result.frames = int(frames.size());
-    result.seconds_per_frame = rendering.seconds() / frames.size();
-    fs::remove(pov_file), fs::remove(png_file);
+/// The frame's surfaces as written (absent files give absent surfaces).
+Frame read_frame(const fs::path& dir, int f) {
+    return {read_if_present(dir / fmt::format("fluid_surface_{:04d}.ply", f)),
+            read_if_present(dir / fmt::format("porous_surface_{:04d}.ply", f))};
+}
 
-    const fs::path movie_tmp = dir / ".movie.mp4";
+void extend(Aabb& box, const Frame& frame) {
+    for (const auto* m : {&frame.fluid, &frame.porous})
+        if (*m)
+            for (const Vec3& x : (*m)->vertices.x) box.extend(x);
+}
+
+std::string read_bytes(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+/// POV-Ray's picture of `pov` as PNG bytes; `stem` names its scratch files in the folder.
+std::string render_png(const RenderView& view, const std::string& stem, const std::string& pov) {
+    const fs::path pov_file = view.dir / (stem + ".pov"), png_file = view.dir / (stem + ".png"),
+                   log_file = view.dir / (stem + ".log");
+    std::ofstream(pov_file) << pov;
+    const RenderOptions& o = view.options;
+    run_tool(fmt::format("povray +I{} +O{} +W{} +H{} +FN -D -V {} {}", quoted(pov_file),
+                         quoted(png_file), view.width, view.height,
+                         o.threads > 0 ? fmt::format("+WT{}", o.threads) : "",
+                         o.preview ? "-A" : fmt::format("+A0.2 +AM2 +R{}", view.samples)),
+             "povray", log_file);
+    std::string png = read_bytes(png_file);
+    fs::remove(pov_file), fs::remove(png_file), fs::remove(log_file);
+    return png;
+}
+
+/// movie.mp4 of render_NNNN.png at the run's frame rate.
+fs::path encode_movie(const fs::path& dir, OutputFolder& folder) {
+    const fs::path movie_tmp = dir / ".movie.mp4", log_file = dir / ".movie.log";
     run_tool(
         fmt::format("ffmpeg -y -loglevel error -framerate {:.6g} -i {} -c:v libx264 "
                     "-pix_fmt yuv420p -movflags +faststart {}",
                     1 / frame_interval(dir), quoted(dir / "render_%04d.png"), quoted(movie_tmp)),
         "ffmpeg", log_file);
-    std::ifstream movie(movie_tmp, std::ios::binary);
-    std::stringstream bytes;
-    bytes << movie.rdbuf();
-    folder.write("movie.mp4", bytes.str());
+    folder.write("movie.mp4", read_bytes(movie_tmp));
     fs::remove(movie_tmp), fs::remove(log_file);
-    result.movie = dir / "movie.mp4";
+    return dir / "movie.mp4";
+}
+
+}  // namespace
+
+RenderView::RenderView(fs::path dir_, const RenderOptions& options_, const RenderSettings& settings,
+                       const Aabb& box)
+    : dir(std::move(dir_)),
+      options(options_),
+      width(options_.width.value_or(settings.width)),
+      height(options_.height.value_or(settings.height)),
+      samples(settings.samples),
+      camera(frame_camera(box, settings, Real(width) / height)) {}
+
+std::string RenderView::scene(const SurfaceMesh* fluid, const SurfaceMesh* porous) const {
+    Frame frame;
+    if (fluid) frame.fluid = *fluid;
+    if (porous) frame.porous = *porous;
+    return pov_scene(frame, camera, options, Real(width) / height);
+}
+
+RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
+    // Frames with a surface, and the box that holds them all.
+    std::vector<Frame> frames;
+    Aabb box;
+    for (int f = 0;; ++f) {
+        Frame frame = read_frame(dir, f);
+        if (!frame.fluid && !frame.porous) break;
+        extend(box, frame);
+        frames.push_back(std::move(frame));
+    }
+    if (frames.empty() || box.empty())
+        throw std::runtime_error(fmt::format(
+            "'{}' has no surface frames (fluid_surface_0000.ply or porous_surface_0000.ply): a "
+            "run writes them unless /output/fluid_surface and /output/porous_surface are off",
+            dir.string()));
+    const RenderView view(dir, options, read_render_settings(dir / "render.json"), box);
+    OutputFolder folder(dir, OutputFolder::Resume{});
+    RenderResult result;
+    Stopwatch rendering;
+    for (size_t f = 0; f < frames.size(); ++f) {
+        const Frame& frame = frames[f];
+        const std::string pov =
+            pov_scene(frame, view.camera, options, Real(view.width) / view.height);
+        folder.write(fmt::format("render_{:04d}.png", f), render_png(view, ".render", pov));
+    }
+    result.frames = int(frames.size());
+    result.seconds_per_frame = rendering.seconds() / frames.size();
+    result.movie = encode_movie(dir, folder);
+    return result;
+}
+
+void check_render_tools() {
+    for (const char* tool : {"povray", "ffmpeg"})
+        if (std::system(fmt::format("command -v {} > /dev/null 2>&1", tool).c_str()) != 0)
+            throw std::runtime_error(fmt::format(
+                "--render needs {}, which is not installed (scripts/install_deps.sh installs it)",
+                tool));
+}
+
+LiveRenderer::LiveRenderer(fs::path dir, const RenderOptions& options,
+                           const RenderSettings& settings, std::optional<Aabb> domain,
+                           const Aabb& walls)
+    : m_dir(std::move(dir)),
+      m_options(options),
+      m_settings(settings),
+      m_domain(domain),
+      m_walls(walls) {}
+
+LiveRenderer::~LiveRenderer() {
+    if (m_job.valid()) m_job.wait();
+}
+
+void LiveRenderer::collect(OutputFolder& folder) {
+    if (!m_job.valid()) return;
+    const auto [png, seconds] = m_job.get();  // rethrows POV-Ray's failure
+    folder.write(fmt::format("render_{:04d}.png", m_job_frame), png);
+    m_seconds += seconds, ++m_rendered;
+}
+
+void LiveRenderer::add(int frame, const SurfaceMesh* fluid, const SurfaceMesh* porous,
+                       OutputFolder& folder) {
+    if (!m_view) {
+        // The camera holds still: the domain, or the walls and this first frame's surfaces.
+        Aabb box = m_domain.value_or(m_walls);
+        if (!m_domain)
+            for (const SurfaceMesh* m : {fluid, porous})
+                if (m)
+                    for (const Vec3& x : m->vertices.x) box.extend(x);
+        if (box.empty()) return;  // nothing to frame yet
+        m_view.emplace(m_dir, m_options, m_settings, box);
+    }
+    std::string pov = m_view->scene(fluid, porous);
+    collect(folder);  // one job at a time: the simulation waits for the previous frame
+    m_job_frame = frame;
+    m_job = std::async(std::launch::async, [view = &*m_view, pov = std::move(pov)] {
+        Stopwatch watch;
+        std::string png = render_png(*view, ".render_live", pov);
+        return std::pair(std::move(png), watch.seconds());
+    });
+}
+
+RenderResult LiveRenderer::finish(int frames, OutputFolder& folder) {
+    collect(folder);
+    RenderResult result;
+    if (!m_view) throw std::runtime_error("the run has no surfaces to render");
+    // Frames the live renderer did not see (a resumed run's earlier ones) are rendered from
+    // their PLY files with the same camera.
+    for (int f = 0; f < frames; ++f) {
+        const std::string name = fmt::format("render_{:04d}.png", f);
+        if (fs::exists(m_dir / name)) continue;
+        const Frame frame = read_frame(m_dir, f);
+        folder.write(name, render_png(*m_view, ".render_live",
+                                      m_view->scene(frame.fluid ? &*frame.fluid : nullptr,
+                                                    frame.porous ? &*frame.porous : nullptr)));
+    }
+    result.frames = frames;
+    result.seconds_per_frame = m_rendered > 0 ? m_seconds / m_rendered : 0;
+    result.movie = encode_movie(m_dir, folder);
     return result;
 }
 

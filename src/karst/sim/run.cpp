@@ -205,6 +205,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     if (opt.resume && opt.out_dir)
         throw SceneError("--out", "no --out with --resume (a resumed run writes into its folder)",
                          opt.out_dir->string());
+    if (opt.render) check_render_tools();
     ThreadLimit thread_limit(opt.threads);
     Stopwatch wall;
     const Model model = build_model(scene);
@@ -231,6 +232,12 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the
         // energy released so far is energy the numerics made; the run says so once.
         record.energy = EnergyAccount(mechanical_energy(model, state));
+    }
+    std::optional<LiveRenderer> live;
+    if (opt.render) {
+        Aabb walls;
+        for (const Vec3& x : model.walls.x) walls.extend(x);
+        live.emplace(result.out_dir, *opt.render, scene.render, scene.domain, walls);
     }
     const bool porous = state.porous.size() > 0;
     const bool meshes = !state.structures.empty();
@@ -287,6 +294,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         if (fluid_frames && o.level_set) parts.level_set = &level_set;
         parts.pscale = 0.5 * model.dx;
         out->write_frame(parts, log);
+        if (live)
+            live->add(out->frames() - 1, parts.fluid_surface, parts.porous_surface, out->folder());
     };
     // The checkpoint of the state now, and only the newest --checkpoint-keep of them kept.
     auto write_checkpoint = [&] {
@@ -413,6 +422,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         result.stats["interrupted"] = {{"signal", result.stop_signal}, {"time", state.time}};
     }
     out->write_stats(result.stats);
+    if (live) result.render = live->finish(out->frames(), out->folder());
     return result;
 }
 

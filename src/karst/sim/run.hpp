@@ -1,5 +1,6 @@
 #pragma once
 // A whole run: model, state, the time loop with frame cadence, output and the watchdog.
+#include "karst/render/render.hpp"
 #include "karst/scene/scene.hpp"
 
 #include <nlohmann/json.hpp>
@@ -29,6 +30,8 @@ struct RunOptions {
     int checkpoint_keep = 2;  ///< newest checkpoints kept in the folder
     /// Continue the run in this folder from its newest checkpoint (frames and stats go there).
     std::optional<std::filesystem::path> resume;
+    /// Render each frame as it is written, and movie.mp4 at the end (render/render.hpp).
+    std::optional<RenderOptions> render;
 };
 
 struct RunResult {
@@ -37,6 +40,8 @@ struct RunResult {
     int stop_signal = 0;  ///< SIGINT or SIGTERM that stopped the run early (sim/stop_signal.hpp)
     std::filesystem::path out_dir;
     nlohmann::json stats;  ///< what stats.json holds
+    std::optional<RenderResult>
+        render;  ///< with RunOptions::render, unless the watchdog stopped it
 };
 
 /// Runs `scene` to its end time, writing frames (or continues it from a checkpoint, bit for bit
