@@ -11,28 +11,28 @@ std::vector<PcaFrame> pca_frames(const std::vector<Vec3>& x, Real h) {
     const Real radius = 2 * h;
     Aabb box;
     for (const Vec3& p : x) box.extend(p);
-    const UniformGrid grid(box.padded(radius), radius);
+    const UniformGrid grid(box.padded(radius), radius / 2);
     CellRanges cells;
     sort_into_cells(grid, x, cells);
 
-    // About 270 neighbours within 2 h = 4 dx: visited in place (itself included), not listed.
+    // About 270 neighbours within 2 h = 4 dx: visited once, in place (itself included), not
+    // listed. The sums are of offsets d = x_j - x_i, so the covariance about the weighted mean,
+    // S2/W - (S1/W)(S1/W)^T, subtracts numbers of the neighbourhood's size, not the domain's.
     std::vector<PcaFrame> frames(x.size());
+    const Real inv_radius3 = 1 / (radius * radius * radius);
     parallel_for(Index(x.size()), [&](Index i) {
         Real weight = 0;
-        Vec3 mean = Vec3::Zero();
+        Vec3 first = Vec3::Zero();
+        Mat3 second = Mat3::Zero();
         Index count = 0;
-        for_each_within(grid, cells, x[i], [&](Index, const Vec3& xj) {
-            const Real r = (xj - x[i]).norm() / radius, w = 1 - r * r * r;
-            weight += w, mean += w * xj, ++count;
+        for_each_within(grid, cells, x[i], radius, [&](Index, const Vec3& xj) {
+            const Vec3 d = xj - x[i];
+            const Real r2 = d.squaredNorm(), w = 1 - r2 * std::sqrt(r2) * inv_radius3;
+            weight += w, first += w * d, second += w * d * d.transpose(), ++count;
         });
-        mean /= weight;
-        Mat3 covariance = Mat3::Zero();
-        for_each_within(grid, cells, x[i], [&](Index, const Vec3& xj) {
-            const Real r = (xj - x[i]).norm() / radius, w = 1 - r * r * r;
-            const Vec3 d = xj - mean;
-            covariance += w * d * d.transpose();
-        });
-        covariance /= weight;
+        const Vec3 offset = first / weight;
+        const Mat3 covariance = second / weight - offset * offset.transpose();
+        const Vec3 mean = x[i] + offset;
         const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);  // ascending
         PcaFrame& f = frames[i];
         f.neighbours = count;

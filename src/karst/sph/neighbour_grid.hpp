@@ -7,6 +7,7 @@
 #include "karst/scene/geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -59,22 +60,31 @@ struct NeighbourLists {
 void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
                      const CellRanges& targets, bool exclude_self, NeighbourLists& out);
 
-/// Calls f(j, x_j) for every particle j of `targets` closer to `at` than grid.cell (strictly), in
-/// the order find_neighbours lists them, without storing a list: for wide searches whose lists
-/// would not fit in memory.
+/// Calls f(j, x_j) for every particle j of `targets` closer to `at` than `radius` (strictly),
+/// scanning the cells within ceil(radius / grid.cell) of at's cell row by row, without storing a
+/// list: for wide searches whose lists would not fit in memory. A cell of half the radius scans
+/// 125 cells of 1/8 the volume, 42 % less space than 27 cells of the radius.
 template <class F>
 void for_each_within(const UniformGrid& grid, const CellRanges& targets, const Vec3& at,
-                     const F& f) {
-    const Real h2 = grid.cell * grid.cell;
+                     Real radius, const F& f) {
+    const Real r2 = radius * radius;
+    const int reach = int(std::ceil(radius / grid.cell - 1e-9));
     const auto c = grid.coords(at);
-    const int x0 = std::max(c[0] - 1, 0), x1 = std::min(c[0] + 1, grid.dims[0] - 1);
-    for (int z = std::max(c[2] - 1, 0); z <= std::min(c[2] + 1, grid.dims[2] - 1); ++z)
-        for (int y = std::max(c[1] - 1, 0); y <= std::min(c[1] + 1, grid.dims[1] - 1); ++y)
+    const int x0 = std::max(c[0] - reach, 0), x1 = std::min(c[0] + reach, grid.dims[0] - 1);
+    for (int z = std::max(c[2] - reach, 0); z <= std::min(c[2] + reach, grid.dims[2] - 1); ++z)
+        for (int y = std::max(c[1] - reach, 0); y <= std::min(c[1] + reach, grid.dims[1] - 1); ++y)
             for (std::uint32_t s = targets.start[grid.linear({x0, y, z})],
                                e = targets.start[grid.linear({x1, y, z}) + 1];
                  s < e; ++s)
-                if ((targets.sorted_x[s] - at).squaredNorm() < h2)
+                if ((targets.sorted_x[s] - at).squaredNorm() < r2)
                     f(Index(targets.order[s]), targets.sorted_x[s]);
+}
+
+/// for_each_within with the radius grid.cell: in the order find_neighbours lists them.
+template <class F>
+void for_each_within(const UniformGrid& grid, const CellRanges& targets, const Vec3& at,
+                     const F& f) {
+    for_each_within(grid, targets, at, grid.cell, f);
 }
 
 /// Permutation sorting `x` along the Morton curve of their grid cells (ties by index).
