@@ -42,10 +42,7 @@ TetMesh mesh_points(const Model& model, const std::vector<Vec3>& x, PfemTimings&
     options.alpha = pe.alpha, options.join_delta = pe.join_delta,
     options.weighted = pe.weighted_alpha;
     const std::vector<Real> size(x.size(), model.dx);
-    // Weighted variant (docs/method.md §5.1): w = (omega_S S + omega_m m/m_bar) (dx/2)^2 with a
-    // saturated, uniform-mass solid: S = 1, m = m_bar.
-    const std::vector<Real> weights(options.weighted ? x.size() : 0,
-                                    (1.0 + 0.2) * 0.25 * model.dx * model.dx);
+    const std::vector<Real> weights(options.weighted ? x.size() : 0, alpha_shape_weight(model.dx));
     TetMesh mesh = build_tet_mesh(x, size, options, weights);
     timings.meshing += watch.seconds();
     return mesh;

@@ -1,6 +1,7 @@
 #include "karst/pfem/merge_stage.hpp"
 
 #include "karst/core/disjoint_sets.hpp"
+#include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/tet_mesh.hpp"
 #include "karst/rigid/fragment_motion.hpp"
 
@@ -19,14 +20,20 @@ struct Contact {
     bool across_crack = false;  ///< some pair is the two halves of one split particle
 };
 
-/// Fragments touching each other, by fragment pair (a < b), from a fresh neighbour search
-/// (dissolution may have removed particles since the step's).
+/// Fragments touching each other, by fragment pair (a < b), from the step's porous neighbour
+/// lists (pairs within h at the step's start: a slow contact moves a small part of h in a step),
+/// or from a fresh search when dissolution removed particles since they were made.
 std::map<std::pair<Index, Index>, Contact> contacts(const Model& model, const State& state) {
     const PorousParticles& p = state.porous.particles;
-    CellRanges cells;
-    NeighbourLists near;
-    sort_into_cells(model.grid, p.x, cells);
-    find_neighbours(model.grid, p.x, cells, true, near);
+    NeighbourLists fresh;
+    const NeighbourLists* lists = &state.porous_scratch.porous_porous;
+    if (Index(lists->count.size()) != p.size()) {
+        CellRanges cells;
+        sort_into_cells(model.grid, p.x, cells);
+        find_neighbours(model.grid, p.x, cells, true, fresh);
+        lists = &fresh;
+    }
+    const NeighbourLists& near = *lists;
     const std::vector<Fragment>& fragments = state.porous.fragments;
     std::map<std::pair<Index, Index>, Contact> found;
     for (Index i = 0; i < p.size(); ++i)
@@ -65,8 +72,7 @@ bool should_merge(const Model& model, const State& state, Index a, const Contact
     MeshOptions options;
     options.alpha = model.scene.poroelastic.alpha, options.weighted = true;
     const std::vector<Real> size(x.size(), model.dx);
-    // The weights of mesh_points (saturated members, S = 1).
-    const std::vector<Real> weights(x.size(), 1.2 * 0.25 * model.dx * model.dx);
+    const std::vector<Real> weights(x.size(), alpha_shape_weight(model.dx));
     const TetMesh mesh = build_tet_mesh(x, size, options, weights);
     Index spanning = 0;
     for (const Tet& t : mesh.tets) {
