@@ -1,6 +1,7 @@
 // `karst render` (issue 14): a cave_soak run renders to one PNG per frame and an MP4 whose frame
 // count ffprobe confirms, and a frame shows water and rock, not a blank picture; `karst run
 // --render` makes its pictures while the run goes on.
+#include "karst/render/wall_picture.hpp"
 #include "support/files.hpp"
 
 #include <gtest/gtest.h>
@@ -142,6 +143,51 @@ TEST(Render, TheRenderBlockOfTheSceneReachesTheRunFolder) {
     EXPECT_EQ(settings["width"], 640);
     EXPECT_EQ(settings["height"], 360);
     EXPECT_EQ(settings["samples"], 3);
+    // The walls, for karst render to draw: the container and its thickness (2 layers x dx).
+    ASSERT_EQ(settings["walls"].size(), 1u);
+    EXPECT_EQ(settings["walls"][0]["container"], true);
+    EXPECT_DOUBLE_EQ(settings["walls"][0]["thickness"].get<double>(), 0.1);
+    EXPECT_EQ(settings["walls"][0]["shape"]["type"], "box");
+    EXPECT_EQ(settings["walls"][0]["shape"]["max"], nlohmann::json::array({0.4, 0.4, 0.4}));
+}
+
+TEST(Render, WallsAreDrawnAsTheirShapes) {
+    auto shape = [](Shape::Kind kind, Vec3 a, Vec3 b, Real radius) {
+        Shape s;
+        s.kind = kind, s.a = a, s.b = b, s.radius = radius;
+        return s;
+    };
+    const Shape pillar = shape(Shape::Kind::Cylinder, {1, 0.3, 0}, {1, 0.3, 0.3}, 0.08);
+    const Shape tank = shape(Shape::Kind::Box, Vec3::Zero(), {1.6, 0.6, 0.8}, 0);
+    Shape ring = shape(Shape::Kind::Difference, Vec3::Zero(), Vec3::Zero(), 0);
+    ring.children = {shape(Shape::Kind::Sphere, Vec3::Zero(), Vec3::Zero(), 1),
+                     shape(Shape::Kind::Sphere, Vec3::Zero(), Vec3::Zero(), 0.5)};
+    const std::vector<PicturedWall> walls{
+        {pillar, false, 0.04}, {tank, true, 0.04}, {ring, false, 0.02}};
+    // render.json keeps every shape, nested ones too.
+    const std::vector<PicturedWall> back = walls_from_json(walls_to_json(walls));
+    ASSERT_EQ(back.size(), 3u);
+    EXPECT_EQ(back[0].shape.kind, Shape::Kind::Cylinder);
+    EXPECT_EQ(back[0].shape.b, pillar.b);
+    EXPECT_EQ(back[0].shape.radius, 0.08);
+    EXPECT_TRUE(back[1].container);
+    ASSERT_EQ(back[2].shape.children.size(), 2u);
+    EXPECT_EQ(back[2].shape.children[1].radius, 0.5);
+    // The obstacle is its own shape; the container a shell of the walls' thickness around the
+    // space it holds, without the walls and lid on the camera's side (here: y < 0 and z > 0.8).
+    const std::string pov = pov_walls(walls, Vec3(0.8, -2, 1.5));
+    EXPECT_NE(pov.find("cylinder { <1,0.3,0>, <1,0.3,0.3>, 0.08 }"), std::string::npos) << pov;
+    EXPECT_NE(pov.find("difference { box { <-0.04,-0.04,-0.04>, <1.64,0.64,0.84> } box { <0,0,0>, "
+                       "<1.6,0.6,0.8> } box { <-2.64,-2.64,-2.64>, <4.24,0.0016,3.44> } box { "
+                       "<-2.64,-2.64,0.7984>, "
+                       "<4.24,3.24,3.44> }"),
+              std::string::npos)
+        << pov;
+    EXPECT_NE(pov.find("difference { sphere { <0,0,0>, 1 } sphere { <0,0,0>, 0.5 } }"),
+              std::string::npos)
+        << pov;
+    EXPECT_THROW(walls_from_json(nlohmann::json::parse(R"([{"shape": {"type": "cone"}}])")),
+                 nlohmann::json::exception);
 }
 
 TEST(Render, ACameraLookingAtItselfOrAMisspeltKeyIsRefused) {

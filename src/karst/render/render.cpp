@@ -3,6 +3,7 @@
 #include "karst/core/timer.hpp"
 #include "karst/io/output_folder.hpp"
 #include "karst/render/ply_reader.hpp"
+#include "karst/render/wall_picture.hpp"
 #include "karst/scene/geometry.hpp"
 
 #include <fmt/format.h>
@@ -121,8 +122,9 @@ Camera frame_camera(const Aabb& box, const RenderSettings& settings, Real aspect
     return c;
 }
 
-std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOptions& options,
-                      Real aspect) {
+std::string pov_scene(const SurfaceMesh* fluid, const SurfaceMesh* porous,
+                      const std::vector<PicturedWall>& walls, const Camera& camera,
+                      const RenderOptions& options, Real aspect) {
     std::string pov = "#version 3.7;\nglobal_settings { assumed_gamma 1.0 max_trace_level 10 }\n";
     pov +=
         "sky_sphere { pigment { gradient z color_map { [0 srgb <0.93,0.95,0.98>] [1 srgb "
@@ -144,19 +146,20 @@ std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOpti
         "plane {{ z, {:.6g} texture {{ pigment {{ checker srgb 0.8 srgb 0.7 scale {:.6g} }} "
         "finish {{ diffuse 0.8 }} }} }}\n",
         camera.ground, r);
-    if (frame.porous && frame.porous->triangle_count() > 0)
-        pov += mesh2(*frame.porous,
+    pov += pov_walls(walls, camera.location);
+    if (porous && porous->triangle_count() > 0)
+        pov += mesh2(*porous,
                      "pigment {{ srgb <{:.4f},{:.4f},{:.4f}> }} finish {{ diffuse 0.85 "
                      "specular 0.05 }}",
                      "");
-    if (frame.fluid && frame.fluid->triangle_count() > 0) {
+    if (fluid && fluid->triangle_count() > 0) {
         if (options.preview)
-            pov += mesh2(*frame.fluid,
+            pov += mesh2(*fluid,
                          "pigment {{ srgbt <{:.4f},{:.4f},{:.4f},0.25> }} finish {{ specular 0.7 "
                          "roughness 0.005 }}",
                          "");
         else
-            pov += mesh2(*frame.fluid,
+            pov += mesh2(*fluid,
                          "pigment {{ srgbf <{:.4f},{:.4f},{:.4f},0.75> }} finish {{ diffuse 0.25 "
                          "specular 0.8 roughness 0.003 reflection {{ 0.03, 0.4 fresnel on }} "
                          "conserve_energy }}",
@@ -165,9 +168,11 @@ std::string pov_scene(const Frame& frame, const Camera& camera, const RenderOpti
     return pov;
 }
 
-RenderSettings read_render_settings(const fs::path& file) {
+/// render.json's settings and walls (defaults and none without the file).
+std::pair<RenderSettings, std::vector<PicturedWall>> read_render_settings(const fs::path& file) {
     RenderSettings s;
-    if (!fs::exists(file)) return s;
+    std::vector<PicturedWall> walls;
+    if (!fs::exists(file)) return {s, walls};
     try {
         const nlohmann::json j = nlohmann::json::parse(std::ifstream(file));
         auto point = [&](const char* name) -> std::optional<Vec3> {
@@ -177,15 +182,16 @@ RenderSettings read_render_settings(const fs::path& file) {
         s.camera_position = point("camera_position"), s.camera_target = point("camera_target");
         s.fov = j.at("fov"), s.width = j.at("width"), s.height = j.at("height");
         s.samples = j.at("samples");
+        if (j.contains("walls")) walls = walls_from_json(j["walls"]);
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(fmt::format("cannot read '{}': {}", file.string(), e.what()));
     }
-    return s;
+    return {s, walls};
 }
 
 }  // namespace
 
-std::string render_settings_json(const RenderSettings& s) {
+std::string render_settings_json(const RenderSettings& s, const std::vector<PicturedWall>& walls) {
     auto point = [](const std::optional<Vec3>& p) {
         return p ? nlohmann::json::array({(*p)[0], (*p)[1], (*p)[2]}) : nlohmann::json();
     };
@@ -194,7 +200,8 @@ std::string render_settings_json(const RenderSettings& s) {
                           {"fov", s.fov},
                           {"width", s.width},
                           {"height", s.height},
-                          {"samples", s.samples}}
+                          {"samples", s.samples},
+                          {"walls", walls_to_json(walls)}}
                .dump(2) +
            "\n";
 }
@@ -252,48 +259,49 @@ fs::path encode_movie(const fs::path& dir, OutputFolder& folder) {
 }  // namespace
 
 RenderView::RenderView(fs::path dir_, const RenderOptions& options_, const RenderSettings& settings,
-                       const Aabb& box)
+                       const Aabb& box, std::vector<PicturedWall> walls_)
     : dir(std::move(dir_)),
       options(options_),
       width(options_.width.value_or(settings.width)),
       height(options_.height.value_or(settings.height)),
       samples(settings.samples),
-      camera(frame_camera(box, settings, Real(width) / height)) {}
+      camera(frame_camera(box, settings, Real(width) / height)),
+      walls(std::move(walls_)) {}
 
 std::string RenderView::scene(const SurfaceMesh* fluid, const SurfaceMesh* porous) const {
-    Frame frame;
-    if (fluid) frame.fluid = *fluid;
-    if (porous) frame.porous = *porous;
-    return pov_scene(frame, camera, options, Real(width) / height);
+    return pov_scene(fluid, porous, walls, camera, options, Real(width) / height);
+}
+
+std::string RenderView::scene(const fs::path& dir, int f) const {
+    const Frame frame = read_frame(dir, f);
+    return scene(frame.fluid ? &*frame.fluid : nullptr, frame.porous ? &*frame.porous : nullptr);
 }
 
 RenderResult render_run(const fs::path& dir, const RenderOptions& options) {
-    // Frames with a surface, and the box that holds them all.
-    std::vector<Frame> frames;
+    // The box that holds every frame's surfaces frames the camera; the frames are read again
+    // one at a time to render them, so a long run does not have to fit in memory.
+    int frames = 0;
     Aabb box;
-    for (int f = 0;; ++f) {
-        Frame frame = read_frame(dir, f);
+    for (;; ++frames) {
+        const Frame frame = read_frame(dir, frames);
         if (!frame.fluid && !frame.porous) break;
         extend(box, frame);
-        frames.push_back(std::move(frame));
     }
-    if (frames.empty() || box.empty())
+    if (frames == 0 || box.empty())
         throw std::runtime_error(fmt::format(
             "'{}' has no surface frames (fluid_surface_0000.ply or porous_surface_0000.ply): a "
             "run writes them unless /output/fluid_surface and /output/porous_surface are off",
             dir.string()));
-    const RenderView view(dir, options, read_render_settings(dir / "render.json"), box);
+    auto [settings, walls] = read_render_settings(dir / "render.json");
+    const RenderView view(dir, options, settings, box, std::move(walls));
     OutputFolder folder(dir, OutputFolder::Resume{});
     RenderResult result;
     Stopwatch rendering;
-    for (size_t f = 0; f < frames.size(); ++f) {
-        const Frame& frame = frames[f];
-        const std::string pov =
-            pov_scene(frame, view.camera, options, Real(view.width) / view.height);
-        folder.write(fmt::format("render_{:04d}.png", f), render_png(view, ".render", pov));
-    }
-    result.frames = int(frames.size());
-    result.seconds_per_frame = rendering.seconds() / frames.size();
+    for (int f = 0; f < frames; ++f)
+        folder.write(fmt::format("render_{:04d}.png", f),
+                     render_png(view, ".render", view.scene(dir, f)));
+    result.frames = frames;
+    result.seconds_per_frame = rendering.seconds() / frames;
     result.movie = encode_movie(dir, folder);
     return result;
 }
@@ -308,12 +316,13 @@ void check_render_tools() {
 
 LiveRenderer::LiveRenderer(fs::path dir, const RenderOptions& options,
                            const RenderSettings& settings, std::optional<Aabb> domain,
-                           const Aabb& walls)
+                           const Aabb& wall_particles, std::vector<PicturedWall> walls)
     : m_dir(std::move(dir)),
       m_options(options),
       m_settings(settings),
       m_domain(domain),
-      m_walls(walls) {}
+      m_wall_particles(wall_particles),
+      m_walls(std::move(walls)) {}
 
 LiveRenderer::~LiveRenderer() {
     if (m_job.valid()) m_job.wait();
@@ -330,13 +339,13 @@ void LiveRenderer::add(int frame, const SurfaceMesh* fluid, const SurfaceMesh* p
                        OutputFolder& folder) {
     if (!m_view) {
         // The camera holds still: the domain, or the walls and this first frame's surfaces.
-        Aabb box = m_domain.value_or(m_walls);
+        Aabb box = m_domain.value_or(m_wall_particles);
         if (!m_domain)
             for (const SurfaceMesh* m : {fluid, porous})
                 if (m)
                     for (const Vec3& x : m->vertices.x) box.extend(x);
         if (box.empty()) return;  // nothing to frame yet
-        m_view.emplace(m_dir, m_options, m_settings, box);
+        m_view.emplace(m_dir, m_options, m_settings, box, m_walls);
     }
     std::string pov = m_view->scene(fluid, porous);
     collect(folder);  // one job at a time: the simulation waits for the previous frame
@@ -357,10 +366,7 @@ RenderResult LiveRenderer::finish(int frames, OutputFolder& folder) {
     for (int f = 0; f < frames; ++f) {
         const std::string name = fmt::format("render_{:04d}.png", f);
         if (fs::exists(m_dir / name)) continue;
-        const Frame frame = read_frame(m_dir, f);
-        folder.write(name, render_png(*m_view, ".render_live",
-                                      m_view->scene(frame.fluid ? &*frame.fluid : nullptr,
-                                                    frame.porous ? &*frame.porous : nullptr)));
+        folder.write(name, render_png(*m_view, ".render_live", m_view->scene(m_dir, f)));
     }
     result.frames = frames;
     result.seconds_per_frame = m_rendered > 0 ? m_seconds / m_rendered : 0;

@@ -184,6 +184,15 @@ nlohmann::json run_stats(const Model& model, const State& state, const RunRecord
     };
 }
 
+/// The scene's walls as karst render draws them.
+std::vector<PicturedWall> pictured_walls(const Scene& scene) {
+    std::vector<PicturedWall> walls;
+    for (const Wall& w : scene.walls)
+        walls.push_back(
+            {w.shape, w.kind == Wall::Kind::Container, w.layers * scene.particle_spacing});
+    return walls;
+}
+
 }  // namespace
 
 RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
@@ -228,7 +237,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         result.out_dir = opt.out_dir ? *opt.out_dir : std::filesystem::path("out") / scene.name;
         out.emplace(result.out_dir, scene.output, opt.overwrite);
         out->write_boundary(model.walls);
-        out->folder().write("render.json", render_settings_json(scene.render));
+        out->folder().write("render.json",
+                            render_settings_json(scene.render, pictured_walls(scene)));
         // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the
         // energy released so far is energy the numerics made; the run says so once.
         record.energy = EnergyAccount(mechanical_energy(model, state));
@@ -237,7 +247,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     if (opt.render) {
         Aabb walls;
         for (const Vec3& x : model.walls.x) walls.extend(x);
-        live.emplace(result.out_dir, *opt.render, scene.render, scene.domain, walls);
+        live.emplace(result.out_dir, *opt.render, scene.render, scene.domain, walls,
+                     pictured_walls(scene));
     }
     const bool porous = state.porous.size() > 0;
     const bool meshes = !state.structures.empty();
