@@ -72,6 +72,8 @@ inline VtkArrays read_vtk_xml(const std::string& file) {
             decode(float{});
         else if (type == "Int64")
             decode(std::int64_t{});
+        else if (type == "Int32")
+            decode(std::int32_t{});
         else if (type == "UInt8")
             decode(std::uint8_t{});
         else

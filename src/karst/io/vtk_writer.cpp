@@ -5,7 +5,9 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string_view>
 
@@ -121,34 +123,46 @@ std::string polydata_bytes(const PointSet& points, const char* kind,
                            const std::vector<std::int64_t>& offsets, bool zlib) {
     std::string blob;
     const auto [point_data, points_offset] = append_points(blob, points, zlib);
+    // Int32 cell arrays (half the bytes) whenever the indices fit, as VTK's own writer does.
+    const std::int64_t largest =
+        std::max<std::int64_t>(offsets.empty() ? 0 : offsets.back(), points.x.size());
+    const bool narrow = largest <= std::numeric_limits<std::int32_t>::max();
+    auto append_cells = [&](const std::vector<std::int64_t>& v) {
+        if (narrow)
+            append_block(blob, std::vector<std::int32_t>(v.begin(), v.end()), zlib);
+        else
+            append_block(blob, v, zlib);
+    };
     const size_t conn_offset = blob.size();
-    append_block(blob, conn, zlib);
+    append_cells(conn);
     const size_t offsets_offset = blob.size();
-    append_block(blob, offsets, zlib);
+    append_cells(offsets);
+    const char* cell_type = narrow ? "Int32" : "Int64";
     const bool verts = std::string_view(kind) == "Verts";
-    return finish(fmt::format("<?xml version=\"1.0\"?>\n"
-                              "{8}"
-                              "  <PolyData>\n"
-                              "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{1}\" "
-                              "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{2}\">\n"
-                              "      <PointData>\n{3}      </PointData>\n"
-                              "      <Points>\n"
-                              "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
-                              "format=\"appended\" offset=\"{4}\"/>\n"
-                              "      </Points>\n"
-                              "      <{5}>\n"
-                              "        <DataArray type=\"Int64\" Name=\"connectivity\" "
-                              "format=\"appended\" offset=\"{6}\"/>\n"
-                              "        <DataArray type=\"Int64\" Name=\"offsets\" "
-                              "format=\"appended\" offset=\"{7}\"/>\n"
-                              "      </{5}>\n"
-                              "    </Piece>\n"
-                              "  </PolyData>\n"
-                              "  <AppendedData encoding=\"raw\">\n   _",
-                              points.x.size(), verts ? offsets.size() : 0,
-                              verts ? 0 : offsets.size(), point_data, points_offset, kind,
-                              conn_offset, offsets_offset, vtk_file_tag("PolyData", zlib)),
-                  blob);
+    return finish(
+        fmt::format("<?xml version=\"1.0\"?>\n"
+                    "{8}"
+                    "  <PolyData>\n"
+                    "    <Piece NumberOfPoints=\"{0}\" NumberOfVerts=\"{1}\" "
+                    "NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"{2}\">\n"
+                    "      <PointData>\n{3}      </PointData>\n"
+                    "      <Points>\n"
+                    "        <DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                    "format=\"appended\" offset=\"{4}\"/>\n"
+                    "      </Points>\n"
+                    "      <{5}>\n"
+                    "        <DataArray type=\"{9}\" Name=\"connectivity\" "
+                    "format=\"appended\" offset=\"{6}\"/>\n"
+                    "        <DataArray type=\"{9}\" Name=\"offsets\" "
+                    "format=\"appended\" offset=\"{7}\"/>\n"
+                    "      </{5}>\n"
+                    "    </Piece>\n"
+                    "  </PolyData>\n"
+                    "  <AppendedData encoding=\"raw\">\n   _",
+                    points.x.size(), verts ? offsets.size() : 0, verts ? 0 : offsets.size(),
+                    point_data, points_offset, kind, conn_offset, offsets_offset,
+                    vtk_file_tag("PolyData", zlib), cell_type),
+        blob);
 }
 
 }  // namespace
