@@ -186,6 +186,16 @@ TEST(Render, WallsAreDrawnAsTheirShapes) {
     EXPECT_NE(pov.find("difference { sphere { <0,0,0>, 1 } sphere { <0,0,0>, 0.5 } }"),
               std::string::npos)
         << pov;
+    // A container whose held space takes away a cylinder shorter than twice the walls'
+    // thickness: the grown shape takes away nothing (not an inside-out cylinder).
+    Shape cup = shape(Shape::Kind::Difference, Vec3::Zero(), Vec3::Zero(), 0);
+    cup.children = {tank, shape(Shape::Kind::Cylinder, {0.5, 0.3, 0.3}, {0.5, 0.3, 0.35}, 0.1)};
+    const std::string cup_pov = pov_walls({{cup, true, 0.04}}, Vec3(0.8, -2, 1.5));
+    EXPECT_EQ(cup_pov.find("cylinder"), cup_pov.rfind("cylinder")) << cup_pov;
+    EXPECT_NE(cup_pov.find("difference { difference { box { <-0.04,-0.04,-0.04>, <1.64,0.64,0.84> "
+                           "} } difference { box"),
+              std::string::npos)
+        << cup_pov;
     EXPECT_THROW(walls_from_json(nlohmann::json::parse(R"([{"shape": {"type": "cone"}}])")),
                  nlohmann::json::exception);
 }

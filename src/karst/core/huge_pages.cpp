@@ -7,6 +7,7 @@
 // builds (whose allocator checks new against delete) keep the library's operator new.
 #include <sys/mman.h>
 
+#include <cerrno>
 #include <cstdint>
 #include <cstdlib>
 #include <new>
@@ -24,8 +25,11 @@ void* allocate(std::size_t bytes) {
         const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(p);
         const std::uintptr_t begin = (at + k_huge_page - 1) & ~(k_huge_page - 1);
         const std::uintptr_t end = (at + bytes) & ~(k_huge_page - 1);
-        // Advice only: where the kernel has no huge pages, the block keeps small ones.
+        // Advice only: where the kernel has no huge pages, the block keeps small ones (and
+        // errno stays as it was).
+        const int saved = errno;
         if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+        errno = saved;
     }
     return p;
 }

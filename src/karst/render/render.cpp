@@ -9,8 +9,14 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <spawn.h>
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <future>
 #include <map>
@@ -53,10 +59,38 @@ std::string quoted(const fs::path& p) {
     return s + "'";
 }
 
-/// Runs a tool with its messages in `log`; a failure names the command and the log's last lines.
+/// Runs `command` under /bin/sh in a process group of its own, so that a Ctrl-C at the terminal
+/// reaches karst (which stops after the current step and still encodes the movie) and not the
+/// tool; std::system would ignore SIGINT in karst while it waits. Returns the wait status.
+int spawn_and_wait(const std::string& command) {
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attr, 0);
+    std::string shell = "sh", flag = "-c", line = command;
+    char* argv[] = {shell.data(), flag.data(), line.data(), nullptr};
+    pid_t pid = 0;
+    const int error = posix_spawn(&pid, "/bin/sh", nullptr, &attr, argv, environ);
+    posix_spawnattr_destroy(&attr);
+    if (error != 0)
+        throw std::runtime_error(
+            fmt::format("cannot start /bin/sh for '{}': {}", command, std::strerror(error)));
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            throw std::runtime_error(
+                fmt::format("waiting for '{}': {}", command, std::strerror(errno)));
+    return status;
+}
+
+/// Runs a tool with its messages in `log`; a failure names the command, how it ended and the
+/// log's last lines.
 void run_tool(const std::string& command, const char* tool, const fs::path& log) {
-    const int status = std::system((command + " > " + quoted(log) + " 2>&1").c_str());
-    if (status == 0) return;
+    const int status = spawn_and_wait(command + " > " + quoted(log) + " 2>&1");
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+    const std::string how = WIFSIGNALED(status)
+                                ? fmt::format("killed by signal {}", WTERMSIG(status))
+                                : fmt::format("exit status {}", WEXITSTATUS(status));
     std::ifstream in(log);
     std::vector<std::string> lines;
     for (std::string line; std::getline(in, line);) lines.push_back(line);
@@ -64,7 +98,7 @@ void run_tool(const std::string& command, const char* tool, const fs::path& log)
     for (size_t k = lines.size() > 4 ? lines.size() - 4 : 0; k < lines.size(); ++k)
         tail += "\n  " + lines[k];
     throw std::runtime_error(
-        fmt::format("{} failed (exit status {}): {}{}", tool, status, command,
+        fmt::format("{} failed ({}): {}{}", tool, how, command,
                     tail.empty() ? "\n(scripts/install_deps.sh installs it)" : tail));
 }
 
@@ -240,6 +274,7 @@ std::string render_png(const RenderView& view, const std::string& stem, const st
              "povray", log_file);
     std::string png = read_bytes(png_file);
     fs::remove(pov_file), fs::remove(png_file), fs::remove(log_file);
+    if (png.empty()) throw std::runtime_error("povray exited without writing a picture: " + stem);
     return png;
 }
 

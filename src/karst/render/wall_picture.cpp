@@ -69,33 +69,39 @@ Shape shape_from_json(const nlohmann::json& j, int depth) {
 }
 
 std::string vec(const Vec3& v) {
-    return fmt::format("<{:.6g},{:.6g},{:.6g}>", v[0], v[1], v[2]);
+    return fmt::format("<{:.9g},{:.9g},{:.9g}>", v[0], v[1], v[2]);
 }
 
 /// The shape grown by `t` (shrunk for t < 0): boxes and radii move out, cylinders also along
-/// their axis; a difference grows its first shape and shrinks what it takes away.
+/// their axis; a difference grows its first shape and shrinks what it takes away. Empty where
+/// shrinking leaves nothing.
 std::string pov_shape(const Shape& s, Real t) {
     switch (s.kind) {
         case Shape::Kind::Box: {
-            Vec3 lo = s.a.array() - t, hi = s.b.array() + t;
-            hi = hi.cwiseMax(lo);
+            const Vec3 lo = s.a.array() - t, hi = s.b.array() + t;
+            if ((hi.array() <= lo.array()).any()) return {};
             return fmt::format("box {{ {}, {} }}", vec(lo), vec(hi));
         }
         case Shape::Kind::Sphere:
-            return fmt::format("sphere {{ {}, {:.6g} }}", vec(s.a),
-                               std::max(s.radius + t, Real(0)));
+            if (s.radius + t <= 0) return {};
+            return fmt::format("sphere {{ {}, {:.9g} }}", vec(s.a), s.radius + t);
         case Shape::Kind::Cylinder: {
             const Vec3 axis = (s.b - s.a).normalized();
-            return fmt::format("cylinder {{ {}, {}, {:.6g} }}", vec(s.a - t * axis),
-                               vec(s.b + t * axis), std::max(s.radius + t, Real(0)));
+            if (s.radius + t <= 0 || (s.b - s.a).norm() + 2 * t <= 0) return {};
+            return fmt::format("cylinder {{ {}, {}, {:.9g} }}", vec(s.a - t * axis),
+                               vec(s.b + t * axis), s.radius + t);
         }
         case Shape::Kind::Union:
         case Shape::Kind::Difference: {
             const bool difference = s.kind == Shape::Kind::Difference;
-            std::string out = difference ? "difference { " : "union { ";
-            for (size_t k = 0; k < s.children.size(); ++k)
-                out += pov_shape(s.children[k], difference && k > 0 ? -t : t) + " ";
-            return out + "}";
+            std::string members;
+            for (size_t k = 0; k < s.children.size(); ++k) {
+                const std::string child = pov_shape(s.children[k], difference && k > 0 ? -t : t);
+                if (difference && k == 0 && child.empty()) return {};
+                if (!child.empty()) members += child + " ";
+            }
+            if (members.empty()) return {};
+            return (difference ? "difference { " : "union { ") + members + "}";
         }
     }
     return {};
@@ -123,10 +129,12 @@ std::vector<PicturedWall> walls_from_json(const nlohmann::json& j) {
 std::string pov_walls(const std::vector<PicturedWall>& walls, const Vec3& camera) {
     std::string pov;
     for (const PicturedWall& w : walls) {
+        const std::string shape = pov_shape(w.shape, 0);
+        if (shape.empty()) continue;
         if (!w.container) {
             pov += fmt::format(
                 "object {{ {} pigment {{ srgb <0.62,0.6,0.57> }} finish {{ diffuse 0.85 }} }}\n",
-                pov_shape(w.shape, 0));
+                shape);
             continue;
         }
         // A cut-away tank: the shell outside the held space's box on each side the camera
@@ -149,7 +157,7 @@ std::string pov_walls(const std::vector<PicturedWall>& walls, const Vec3& camera
         pov += fmt::format(
             "difference {{ {} {}{} pigment {{ srgb <0.8,0.82,0.84> }} finish {{ diffuse 0.8 "
             "specular 0.1 }} }}\n",
-            pov_shape(w.shape, w.thickness), pov_shape(w.shape, 0), cuts);
+            pov_shape(w.shape, w.thickness), shape, cuts);
     }
     return pov;
 }
