@@ -267,13 +267,23 @@ std::string render_png(const RenderView& view, const std::string& stem, const st
                    log_file = view.dir / (stem + ".log");
     std::ofstream(pov_file) << pov;
     const RenderOptions& o = view.options;
-    run_tool(fmt::format("povray +I{} +O{} +W{} +H{} +FN -D -V {} {}", quoted(pov_file),
-                         quoted(png_file), view.width, view.height,
-                         o.threads > 0 ? fmt::format("+WT{}", o.threads) : "",
-                         o.preview ? "-A" : fmt::format("+A0.2 +AM2 +R{}", view.samples)),
-             "povray", log_file);
+    // The scratch files go also when POV-Ray fails (its log's tail is in the message).
+    auto remove_scratch = [&] {
+        std::error_code ignored;
+        for (const fs::path& f : {pov_file, png_file, log_file}) fs::remove(f, ignored);
+    };
+    try {
+        run_tool(fmt::format("povray +I{} +O{} +W{} +H{} +FN -D -V {} {}", quoted(pov_file),
+                             quoted(png_file), view.width, view.height,
+                             o.threads > 0 ? fmt::format("+WT{}", o.threads) : "",
+                             o.preview ? "-A" : fmt::format("+A0.2 +AM2 +R{}", view.samples)),
+                 "povray", log_file);
+    } catch (...) {
+        remove_scratch();
+        throw;
+    }
     std::string png = read_bytes(png_file);
-    fs::remove(pov_file), fs::remove(png_file), fs::remove(log_file);
+    remove_scratch();
     if (png.empty()) throw std::runtime_error("povray exited without writing a picture: " + stem);
     return png;
 }
@@ -365,13 +375,19 @@ LiveRenderer::~LiveRenderer() {
 
 void LiveRenderer::collect(OutputFolder& folder) {
     if (!m_job.valid()) return;
-    const auto [png, seconds] = m_job.get();  // rethrows POV-Ray's failure
-    folder.write(fmt::format("render_{:04d}.png", m_job_frame), png);
-    m_seconds += seconds, ++m_rendered;
+    try {
+        const auto [png, seconds] = m_job.get();
+        folder.write(fmt::format("render_{:04d}.png", m_job_frame), png);
+        m_seconds += seconds, ++m_rendered;
+    } catch (const std::exception& e) {
+        // The simulation goes on (its frames matter more than their pictures); finish() says.
+        if (m_failure.empty()) m_failure = fmt::format("frame {}: {}", m_job_frame, e.what());
+    }
 }
 
 void LiveRenderer::add(int frame, const SurfaceMesh* fluid, const SurfaceMesh* porous,
                        OutputFolder& folder) {
+    if (!m_failure.empty()) return;
     if (!m_view) {
         // The camera holds still: the domain, or the walls and this first frame's surfaces.
         Aabb box = m_domain.value_or(m_wall_particles);
@@ -394,6 +410,11 @@ void LiveRenderer::add(int frame, const SurfaceMesh* fluid, const SurfaceMesh* p
 
 RenderResult LiveRenderer::finish(int frames, OutputFolder& folder) {
     collect(folder);
+    if (!m_failure.empty())
+        throw std::runtime_error(
+            fmt::format("rendering stopped at {} (the run's frames and stats.json are written; "
+                        "karst render renders them)",
+                        m_failure));
     RenderResult result;
     if (!m_view) throw std::runtime_error("the run has no surfaces to render");
     // Frames the live renderer did not see (a resumed run's earlier ones) are rendered from

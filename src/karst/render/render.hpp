@@ -79,7 +79,8 @@ public:
     /// Sends frame `frame` to POV-Ray after writing the previous frame's picture into `folder`.
     void add(int frame, const SurfaceMesh* fluid, const SurfaceMesh* porous, OutputFolder& folder);
     /// Writes the last picture, renders frames below `frames` that have none (a resumed run's
-    /// earlier frames) from their PLY files, and encodes movie.mp4.
+    /// earlier frames) from their PLY files, and encodes movie.mp4. A picture that failed during
+    /// the run (which went on without pictures) throws here, after the run's output is written.
     RenderResult finish(int frames, OutputFolder& folder);
 
 private:
@@ -93,6 +94,7 @@ private:
     std::optional<RenderView> m_view;  ///< set at the first frame with something to frame
     std::future<std::pair<std::string, double>> m_job;  ///< PNG bytes and POV-Ray seconds
     int m_job_frame = -1, m_rendered = 0;
+    std::string m_failure;  ///< the first picture that failed; no later frame is sent
     double m_seconds = 0;
 };
 
