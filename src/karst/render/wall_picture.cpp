@@ -1,14 +1,15 @@
 #include "karst/render/wall_picture.hpp"
 
+#include "karst/scene/scene.hpp"
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-
-#include <algorithm>
 
 namespace karst {
 
 namespace {
 
+/// The scene's shape types by Shape::Kind (read back by read_shape).
 constexpr const char* k_kind_names[] = {"box", "sphere", "cylinder", "union", "difference"};
 
 nlohmann::json point(const Vec3& p) {
@@ -34,38 +35,6 @@ nlohmann::json shape_to_json(const Shape& s) {
             break;
     }
     return j;
-}
-
-Vec3 read_point(const nlohmann::json& j) {
-    return {j.at(0).get<Real>(), j.at(1).get<Real>(), j.at(2).get<Real>()};
-}
-
-Shape shape_from_json(const nlohmann::json& j, int depth) {
-    if (depth > 64) throw nlohmann::json::other_error::create(501, "shapes nest too deep", &j);
-    Shape s;
-    const std::string kind = j.at("type");
-    const auto* name = std::find(std::begin(k_kind_names), std::end(k_kind_names), kind);
-    if (name == std::end(k_kind_names))
-        throw nlohmann::json::other_error::create(501, "unknown shape kind " + kind, &j);
-    s.kind = Shape::Kind(name - std::begin(k_kind_names));
-    switch (s.kind) {
-        case Shape::Kind::Box:
-            s.a = read_point(j.at("min")), s.b = read_point(j.at("max"));
-            break;
-        case Shape::Kind::Sphere:
-            s.a = read_point(j.at("center")), s.radius = j.at("radius");
-            break;
-        case Shape::Kind::Cylinder:
-            s.a = read_point(j.at("base")), s.b = read_point(j.at("top")),
-            s.radius = j.at("radius");
-            break;
-        case Shape::Kind::Union:
-        case Shape::Kind::Difference:
-            for (const nlohmann::json& c : j.at("shapes"))
-                s.children.push_back(shape_from_json(c, depth + 1));
-            break;
-    }
-    return s;
 }
 
 std::string vec(const Vec3& v) {
@@ -120,9 +89,11 @@ nlohmann::json walls_to_json(const std::vector<PicturedWall>& walls) {
 
 std::vector<PicturedWall> walls_from_json(const nlohmann::json& j) {
     std::vector<PicturedWall> walls;
-    for (const nlohmann::json& w : j)
-        walls.push_back({shape_from_json(w.at("shape"), 0), w.at("container").get<bool>(),
-                         w.at("thickness").get<Real>()});
+    for (size_t i = 0; i < j.size(); ++i) {
+        const nlohmann::json& w = j.at(i);
+        walls.push_back({read_shape(w.at("shape"), fmt::format("/walls/{}/shape", i)),
+                         w.at("container").get<bool>(), w.at("thickness").get<Real>()});
+    }
     return walls;
 }
 

@@ -19,7 +19,7 @@ struct PicturedWall {
 };
 
 nlohmann::json walls_to_json(const std::vector<PicturedWall>& walls);
-/// Throws nlohmann::json::exception on a malformed list.
+/// Throws nlohmann::json::exception on a malformed list (SceneError for an impossible shape).
 std::vector<PicturedWall> walls_from_json(const nlohmann::json& j);
 
 /// POV-Ray objects (CSG of box, sphere, cylinder) for the walls seen from `camera`, with their

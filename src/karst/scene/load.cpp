@@ -45,31 +45,32 @@ T option(const json& v, std::initializer_list<std::pair<const char*, T>> options
     throw std::logic_error("scene reader: no value for the option '" + name + "'");
 }
 
+}  // namespace
+
 Shape read_shape(const json& j, const std::string& path) {
     Shape s;
-    const std::string type = j["type"];
+    const std::string type = j.at("type");
     if (type == "box") {
-        s.kind = Shape::Kind::Box, s.a = vec3(j["min"]), s.b = vec3(j["max"]);
+        s.kind = Shape::Kind::Box, s.a = vec3(j.at("min")), s.b = vec3(j.at("max"));
         for (int d = 0; d < 3; ++d)
             if (!(s.b[d] > s.a[d]))
                 throw SceneError(path + "/max", fmt::format("max[{}] > min[{}] = {}", d, d, s.a[d]),
                                  fmt::format("{}", s.b[d]));
     } else if (type == "sphere") {
-        s.kind = Shape::Kind::Sphere, s.a = vec3(j["center"]), s.radius = j["radius"];
+        s.kind = Shape::Kind::Sphere, s.a = vec3(j.at("center")), s.radius = j.at("radius");
     } else if (type == "cylinder") {
-        s.kind = Shape::Kind::Cylinder, s.a = vec3(j["base"]), s.b = vec3(j["top"]),
-        s.radius = j["radius"];
+        s.kind = Shape::Kind::Cylinder, s.a = vec3(j.at("base")), s.b = vec3(j.at("top")),
+        s.radius = j.at("radius");
         if ((s.b - s.a).norm() <= 0)
-            throw SceneError(path + "/top", "a point different from base", j["top"].dump());
+            throw SceneError(path + "/top", "a point different from base", j.at("top").dump());
     } else {
         s.kind = type == "union" ? Shape::Kind::Union : Shape::Kind::Difference;
-        for (size_t i = 0; i < j["shapes"].size(); ++i)
-            s.children.push_back(read_shape(j["shapes"][i], fmt::format("{}/shapes/{}", path, i)));
+        const json& shapes = j.at("shapes");
+        for (size_t i = 0; i < shapes.size(); ++i)
+            s.children.push_back(read_shape(shapes[i], fmt::format("{}/shapes/{}", path, i)));
     }
     return s;
 }
-
-}  // namespace
 
 Scene parse_scene(const std::string& text) {
     json doc = read_scene_json(text);

@@ -6,6 +6,8 @@
 #include "karst/core/types.hpp"
 #include "karst/scene/geometry.hpp"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -199,6 +201,11 @@ struct Scene {
 
 /// Parses and validates scene text; throws SceneError (path, expected, found) on any problem.
 Scene parse_scene(const std::string& text);
+
+/// A shape as the scene writes it (`type` and its keys; docs/scene_format.md), for a document
+/// the schema validated or one karst wrote (render.json). Errors name `path`; a missing key or a
+/// wrong type throws nlohmann::json::exception.
+Shape read_shape(const nlohmann::json& j, const std::string& path);
 /// Reads a scene file; a missing or unreadable file is a SceneError too.
 Scene load_scene_file(const std::string& path);
 /// The built-in default scene (scenes/dam_break_obstacle.json, compiled in).
