@@ -167,8 +167,9 @@ TEST(PoroelasticScene, CliWritesMeshFramesListedInMeshCaseAndStats) {
     const std::string mesh_case = read_text(out / "mesh.case");
     EXPECT_NE(mesh_case.find("number of steps: 3\nfilename numbers:\n0 0 0\n"), std::string::npos)
         << mesh_case;
-    for (const char* array : {"displacement", "pore_pressure", "porosity", "permeability",
-                              "effective_stress", "principal_stress", "crack_candidate"}) {
+    for (const char* array :
+         {"displacement", "pore_pressure", "porosity", "permeability", "effective_stress",
+          "principal_stress", "crack_candidate", "support_force"}) {
         EXPECT_NE(mesh_case.find(fmt::format(" {} mesh_{}_****.ens", array, array)),
                   std::string::npos)
             << array;
@@ -218,6 +219,57 @@ TEST(PoroelasticScene, APlatenMovedByATimeTableStrainsTheBarUniformly) {
                 << "node " << a << " at t = " << t;
             ASSERT_NEAR(stress.effective[a](1, 1), 0, 1e-5 * 1e6 * delta / L);
         }
+        // The force that moves the platen, E A delta / L with A = 0.2 x 0.2 m between the outer
+        // node layers, and the opposite one at the held end; nothing across the bar.
+        Vec3 moving = Vec3::Zero(), held = Vec3::Zero();
+        ASSERT_EQ(s.support_force.size(), size_t(s.mesh.node_count()));
+        for (Index a = 0; a < s.mesh.node_count(); ++a)
+            (s.mesh.nodes[a].x() > 0.6 ? moving : held) += s.support_force[a];
+        const Real F = 1e6 * 0.04 * delta / L;
+        EXPECT_NEAR(moving.x(), F, 1e-5 * F) << "t = " << t;
+        EXPECT_NEAR(held.x(), -F, 1e-5 * F) << "t = " << t;
+        EXPECT_NEAR(moving.y(), 0, 1e-9 * F);
+        EXPECT_NEAR(moving.z(), 0, 1e-9 * F);
+    }
+}
+
+TEST(PoroelasticScene, TheSupportsCarryTheWeightOfAnUndrainedBlock) {
+    // A block held at its base (all axes), drained only at its top, under its own weight: the
+    // supports' forces balance the weight rho g V whatever the pore pressure carries inside
+    // (K u - Q p has no net force), and only the base nodes carry them. (A base too narrow for
+    // its height counts as a hinge, whose rigid-mode spring would take a share of the weight.)
+    // Both element kinds: P1 tets and the M21 polyhedra (whose K_cc comes from the full K).
+    for (const char* elements : {"p1", "mfem_polyhedra"}) {
+        test::Simulation sim(fmt::format(R"({{
+      "name": "weight", "particle_spacing": 0.1, "gravity": [0, 0, -9.81],
+      "poroelastic": {{ "time_step": 0.05, "shape_functions": "{}" }},
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [0.6, 0.6, 0.5] }},
+        "material": {{ "porosity": 0.3, "permeability": 1e-12, "youngs_modulus": 1e6, "poisson_ratio": 0.3,
+                      "solid_density": 2600, "tensile_strength": 1e9 }},
+        "constraints": [
+          {{ "kind": "drained", "region": {{ "type": "box", "min": [-1, -1, 0.5], "max": [2, 2, 2] }} }},
+          {{ "kind": "fixed", "axes": "xyz", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 0] }} }} ] }} ]
+    }})",
+                                         elements));
+        sim.advance();
+        const Structure& s = sim.state.structures.structures.at(0);
+        const BiotProblem& problem =
+            sim.state.biot_cache.find(0, s.mesh_version)->solver->problem();
+        Real volume = 0, largest_p = 0;
+        for (Index e = 0; e < s.mesh.tet_count(); ++e) volume += s.mesh.tet_volume(e);
+        for (Real p : s.fields.p) largest_p = std::max(largest_p, p);
+        ASSERT_GT(largest_p, 100) << "the pore pressure should carry part of the weight";
+        const Real weight = problem.material.bulk_density * 9.81 * volume;
+        Vec3 total = Vec3::Zero();
+        for (Index a = 0; a < s.mesh.node_count(); ++a) {
+            total += s.support_force[a];
+            if (s.mesh.nodes[a].z() > 0.1) {
+                ASSERT_EQ(s.support_force[a], Vec3::Zero()) << a << " " << elements;
+            }
+        }
+        EXPECT_NEAR(total.z(), weight, 1e-9 * weight) << elements;
+        EXPECT_NEAR(total.x(), 0, 1e-9 * weight);
+        EXPECT_NEAR(total.y(), 0, 1e-9 * weight);
     }
 }
 

@@ -31,6 +31,7 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
             polyhedral_elements(mesh, 1e-4 * spacing / std::max<Index>(1, mesh.tet_count()));
         assemble_polyhedral_mechanics();
         std::tie(K_ff, K_fc) = u_dofs.split(K);
+        K_cc = u_dofs.prescribed_block(K);
     } else {
         assemble_p1_mechanics();
     }
@@ -244,6 +245,30 @@ void BiotSolver::Impl::apply_boundary_values(const std::vector<Vec3>& nodal_forc
     for (Index a = 0; a < n; ++a)
         if (problem.drained[a] && !drained_pressure.empty()) p_prescribed[a] = drained_pressure[a];
     elastic_lift = K_fc * u_dofs.gather_prescribed(u_prescribed);
+}
+
+std::vector<Vec3> BiotSolver::support_forces(const BiotFields& fields) const {
+    const Impl& m = *m_impl;
+    KARST_CHECK(fields.u.size() == size_t(m.n) && fields.p.size() == size_t(m.n));
+    const Vector u = Eigen::Map<const Vector>(fields.u[0].data(), 3 * m.n);
+    const Vector p = Eigen::Map<const Vector>(fields.p.data(), m.n);
+    // K_cf = K_fc^T (K is symmetric).
+    const Vector u_c = m.u_dofs.gather_prescribed(u);
+    const Vector internal = m.K_fc.transpose() * m.u_dofs.gather_free(u) + m.K_cc * u_c;
+    const Vector balance = m.u_dofs.gather_prescribed(m.Q * p + m.f_ext);
+    // Nodes outside every tet are held without equations: they have no support to report.
+    std::vector<char> attached(m.n, 0);
+    for (const Tet& t : m.mesh.tets)
+        for (Index a : t) attached[a] = 1;
+    std::vector<Vec3> force(m.n, Vec3::Zero());
+    for (Index a = 0, k = 0; a < m.n; ++a)
+        for (int c = 0; c < 3; ++c) {
+            if (m.u_dofs.free_index[3 * a + c] >= 0) continue;
+            if (attached[a] && Index(m.problem.fixed.size()) > a && (m.problem.fixed[a] & (1 << c)))
+                force[a][c] = internal[k] - balance[k];
+            ++k;
+        }
+    return force;
 }
 
 const BiotProblem& BiotSolver::problem() const {

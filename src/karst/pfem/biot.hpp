@@ -141,6 +141,11 @@ public:
                              const std::vector<Vec3>& prescribed_u,
                              const std::vector<Real>& drained_pressure);
 
+    /// The force each support exerts on its node (N, body frame) in the equilibrium of `fields`
+    /// under the last call's loads: K u - Q p - f_ext on the prescribed components, zero on the
+    /// free ones. A moving platen's total is the sum over its nodes.
+    std::vector<Vec3> support_forces(const BiotFields& fields) const;
+
     const BiotProblem& problem() const;
     Real seconds_assembly() const;
     Real seconds_elastic_factorisation() const;

@@ -77,7 +77,8 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
     std::vector<int> prescribed_index(3 * n, -1);
     for (int i = 0, k = 0; i < 3 * n; ++i)
         if (u_dofs.free_index[i] < 0) prescribed_index[i] = k++;
-    std::vector<Triplets> lift_entries(n);  // K_fc, per column-owning node b
+    std::vector<Triplets> lift_entries(n);     // K_fc, per column-owning node b
+    std::vector<Triplets> support_entries(n);  // K_cc, likewise
     parallel_for(n, [&](Index b) {
         const auto& nb = neighbours[b];
         std::vector<Mat3> block(nb.size(), Mat3::Zero());
@@ -105,7 +106,15 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
         // K_ff columns of b (= rows, K is symmetric) and the lift of prescribed neighbours.
         for (int d = 0; d < 3; ++d) {
             const int col = free_u(b, d);
-            if (col < 0) continue;
+            if (col < 0) {
+                for (size_t pos = 0; pos < nb.size(); ++pos)
+                    for (int c = 0; c < 3; ++c)
+                        if (free_u(nb[pos], c) < 0)
+                            support_entries[b].emplace_back(prescribed_index[3 * nb[pos] + c],
+                                                            prescribed_index[3 * b + d],
+                                                            block[pos](d, c));
+                continue;
+            }
             int at = k_outer[col];
             for (size_t pos = 0; pos < nb.size(); ++pos)
                 for (int c = 0; c < 3; ++c) {
@@ -132,6 +141,10 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
     for (const Triplets& t : lift_entries) lift.insert(lift.end(), t.begin(), t.end());
     K_fc.resize(nf, 3 * n - nf);
     K_fc.setFromTriplets(lift.begin(), lift.end());
+    Triplets support;
+    for (const Triplets& t : support_entries) support.insert(support.end(), t.begin(), t.end());
+    K_cc.resize(3 * n - nf, 3 * n - nf);
+    K_cc.setFromTriplets(support.begin(), support.end());
     storage = problem.material.storage * lumped_volume;
 }
 

@@ -30,6 +30,7 @@ struct BiotSolver::Impl {
 
     DofSplit u_dofs{{}}, p_dofs{{}};
     SparseMatrix K_ff, K_fc, H_ff, H_fc;
+    SparseMatrix K_cc;    // prescribed rows and columns: with K_fc, the supports' reactions
     Vector elastic_lift;  // K_fc u_c
     // Rigid platens: free displacement rows = tie * (unknowns with each platen's members as one);
     // the elasticity solved is tie^T K_ff tie. Empty (0 columns) without platens.

@@ -251,8 +251,9 @@ void append_arrays(PointSet& into, const PointSet& local) {
 }
 
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
-                       const BiotFields& fields, const PorousMaterial& material,
-                       const std::vector<Mat3>& node_tensors, bool feedback) {
+                       const BiotFields& fields, const std::vector<Vec3>& support_force,
+                       const PorousMaterial& material, const std::vector<Mat3>& node_tensors,
+                       bool feedback) {
     const Index offset = Index(frame.nodes.x.size());
     const Index n = mesh.node_count();
     const NodalStress stress = nodal_stress(mesh, problem.material, fields);
@@ -272,6 +273,9 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
     local.add_symmetric_tensor("effective_stress", stress.effective);
     local.add_vector("principal_stress", stress.principal);
     local.add_scalar("crack_candidate", crack);
+    local.add_vector("support_force", support_force.size() == size_t(n)
+                                          ? support_force
+                                          : std::vector<Vec3>(n, Vec3::Zero()));
     append_arrays(frame.nodes, local);
     frame.nodes.x.insert(frame.nodes.x.end(), mesh.nodes.begin(), mesh.nodes.end());
     for (const Tet& t : mesh.tets)

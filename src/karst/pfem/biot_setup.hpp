@@ -79,10 +79,12 @@ void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMater
 /// Appends the mesh (nodes at `mesh.nodes`, tets) to `frame`, with the point arrays
 /// displacement, pore_pressure, porosity and permeability (6 components) as the pores use them
 /// (the call's M23 and M24 with `feedback`, else the rest values phi0 and K0), effective_stress
-/// (6), principal_stress (3) and crack_candidate (sigma'_1 / sigma_t, M25).
+/// (6), principal_stress (3), crack_candidate (sigma'_1 / sigma_t, M25) and support_force (3,
+/// zero where `support_force` does not cover the mesh: no call on it yet).
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
-                       const BiotFields& fields, const PorousMaterial& material,
-                       const std::vector<Mat3>& node_tensors, bool feedback);
+                       const BiotFields& fields, const std::vector<Vec3>& support_force,
+                       const PorousMaterial& material, const std::vector<Mat3>& node_tensors,
+                       bool feedback);
 
 /// Appends the arrays of `local` to those of `into` (by name), creating them for the first solid.
 void append_arrays(PointSet& into, const PointSet& local);

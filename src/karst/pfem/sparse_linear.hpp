@@ -47,6 +47,21 @@ struct DofSplit {
         Afc.setFromTriplets(fc.begin(), fc.end());
         return {std::move(Aff), std::move(Afc)};
     }
+    /// A(prescribed, prescribed) of a square matrix.
+    SparseMatrix prescribed_block(const SparseMatrix& A) const {
+        std::vector<int> prescribed_index(free_index.size(), -1);
+        int prescribed_count = 0;
+        for (size_t i = 0; i < free_index.size(); ++i)
+            if (free_index[i] < 0) prescribed_index[i] = prescribed_count++;
+        Triplets cc;
+        for (int col = 0; col < A.outerSize(); ++col)
+            for (SparseMatrix::InnerIterator it(A, col); it; ++it)
+                if (prescribed_index[it.row()] >= 0 && prescribed_index[col] >= 0)
+                    cc.emplace_back(prescribed_index[it.row()], prescribed_index[col], it.value());
+        SparseMatrix Acc(prescribed_count, prescribed_count);
+        Acc.setFromTriplets(cc.begin(), cc.end());
+        return Acc;
+    }
     Vector gather_free(const Vector& x) const {
         Vector out(free_count);
         for (size_t i = 0; i < free_index.size(); ++i)

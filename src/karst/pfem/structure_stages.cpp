@@ -246,6 +246,7 @@ void solve_structures(const Model& model, State& state, Real time, bool again) {
             s.u_from[a] = i >= 0 ? Vec3(p.x[i] - st.rest_x[s.node_id[a]]) : s.fields.u[a];
         }
         const BiotCallReport r = solver.advance(dt, s.fields);
+        s.support_force = solver.support_forces(s.fields);
         s.flow_time_step = solver.flow_time_step();
         st.timings.factorisation += r.seconds_flow_factorisation,
             st.timings.iterations += r.seconds_iterations;
@@ -312,8 +313,8 @@ void append_structure_meshes(const Model& model, State& state, MeshFrame& frame)
     for (size_t slot = 0; slot < state.structures.structures.size(); ++slot) {
         const Structure& s = state.structures.structures[slot];
         append_mesh_frame(frame, s.mesh, solver_of(model, state, slot).problem(), s.fields,
-                          model.scene.porous_solids[s.solid].material, s.node_tensors,
-                          model.scene.poroelastic.permeability_feedback);
+                          s.support_force, model.scene.porous_solids[s.solid].material,
+                          s.node_tensors, model.scene.poroelastic.permeability_feedback);
     }
 }
 

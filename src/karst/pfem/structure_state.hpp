@@ -28,6 +28,9 @@ struct Structure {
     TetMesh mesh;                    ///< on the rest positions X (world frame: anchored)
     std::vector<ElementLink> links;  ///< face adjacencies of mesh.tets
     BiotFields fields;               ///< u, p of the last call, per node
+    /// Per node: the force of its supports in the last call's equilibrium (N; empty before the
+    /// first call on this mesh). BiotSolver::support_forces says what it holds.
+    std::vector<Vec3> support_force;
     std::vector<Vec3> u_from;  ///< per node: u of the call before the last (the particles' start)
     std::vector<Mat3> node_tensors;        ///< K0 per node (body frame), m^2
     std::vector<Real> permeability_scale;  ///< per node: k/k0 of the last feedback (M24)

@@ -64,9 +64,9 @@ void fields(Ar& ar, BiotFields& f) {
 
 template <class Ar>
 void fields(Ar& ar, Structure& s) {
-    ar(s.fragment, s.solid, s.mesh_version, s.node_id, s.mesh, s.links, s.fields, s.u_from,
-       s.node_tensors, s.permeability_scale, s.mobility_scale, s.flow_time_step, s.well_shaped,
-       s.distorted, s.grown);
+    ar(s.fragment, s.solid, s.mesh_version, s.node_id, s.mesh, s.links, s.fields, s.support_force,
+       s.u_from, s.node_tensors, s.permeability_scale, s.mobility_scale, s.flow_time_step,
+       s.well_shaped, s.distorted, s.grown);
 }
 
 template <class Ar>
