@@ -86,6 +86,9 @@ void expect_same_run(const fs::path& a, const fs::path& b) {
             EXPECT_TRUE(read_text(a / name) == read_text(b / name)) << name << " differs";
     }
     EXPECT_EQ(stats_without_timings(a), stats_without_timings(b));
+    if (fs::exists(a / "supports.csv")) {
+        EXPECT_TRUE(read_text(a / "supports.csv") == read_text(b / "supports.csv"));
+    }
 }
 
 /// Keeps the checkpoints of `dir` up to the `kept`-th (in step order) and every frame file, as a
@@ -128,6 +131,11 @@ TEST(Checkpoint, AResumedRunThatCracksAndSplitsNodesContinuesBitForBit) {
     EXPECT_GT(geometries.size(), 1u);
     const std::string log = read_text(straight / "log.csv");
     EXPECT_LT(geometries.size(), size_t(std::count(log.begin(), log.end(), '\n') - 1));
+    // One row per frame for the fixed base (constraint 0) and none for anything else.
+    const std::string supports = read_text(straight / "supports.csv");
+    EXPECT_EQ(std::count(supports.begin(), supports.end(), '\n'),
+              std::count(log.begin(), log.end(), '\n'));
+    EXPECT_NE(supports.find("\n5,0.5,0,0,fixed,"), std::string::npos) << supports;
     fs::copy(straight, resumed, fs::copy_options::recursive);
     forget_checkpoints_after(resumed, 1);  // at 0.05 s, with cracks to come
     ASSERT_EQ(karst("run " + box.scene() + " --quiet --resume " + resumed.string()), 0);

@@ -6,6 +6,7 @@
 
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/porosity.hpp"
+#include "karst/pfem/structure_stages.hpp"
 #include "karst/scene/scene_error.hpp"
 
 #include <gtest/gtest.h>
@@ -230,6 +231,20 @@ TEST(PoroelasticScene, APlatenMovedByATimeTableStrainsTheBarUniformly) {
         EXPECT_NEAR(held.x(), -F, 1e-5 * F) << "t = " << t;
         EXPECT_NEAR(moving.y(), 0, 1e-9 * F);
         EXPECT_NEAR(moving.z(), 0, 1e-9 * F);
+        // supports.csv's rows: the held end (constraint 1) and the platen (2), 9 nodes each,
+        // with the force-displacement pair a lab test plots.
+        const std::vector<SupportLog> rows = structure_supports(sim.model, sim.state, t);
+        ASSERT_EQ(rows.size(), 2u);
+        EXPECT_EQ(rows[0].constraint, 1);
+        EXPECT_EQ(rows[1].constraint, 2);
+        for (const SupportLog& row : rows) {
+            EXPECT_EQ(row.kind, "fixed");
+            EXPECT_EQ(row.nodes, 9);
+        }
+        EXPECT_NEAR(rows[0].force.x(), -F, 1e-5 * F);
+        EXPECT_NEAR(rows[1].force.x(), F, 1e-5 * F);
+        EXPECT_NEAR(rows[0].displacement.x(), 0, 1e-12);
+        EXPECT_NEAR(rows[1].displacement.x(), delta, 1e-9 * delta);
     }
 }
 
@@ -320,6 +335,20 @@ TEST(PoroelasticScene, ARigidPlatenUnderATotalForceSettlesAConfinedColumnLikeIts
         EXPECT_NEAR(by_platen[k], expected, 1e-3 * std::abs(expected)) << "platen node " << k;
         EXPECT_NEAR(by_platen[k], by_traction[k], 0.01 * std::abs(expected)) << "node " << k;
         EXPECT_NEAR(by_platen[k], by_platen[0], 1e-12 * std::abs(expected)) << "node " << k;
+    }
+    // supports.csv: the platen (constraint 6) at its force and common settlement; the base
+    // roller (5) carries the 900 N back and the side rollers nothing along z.
+    const std::vector<SupportLog> rows = structure_supports(platen.model, platen.state, 1.0);
+    ASSERT_EQ(rows.size(), 6u);
+    const SupportLog& top = rows[5];
+    EXPECT_EQ(top.constraint, 6);
+    EXPECT_EQ(top.kind, "platen");
+    EXPECT_EQ(top.nodes, 16);
+    EXPECT_EQ(top.force, Vec3(0, 0, -F));
+    EXPECT_NEAR(top.displacement.z(), by_platen[0], 1e-12 * std::abs(expected));
+    EXPECT_NEAR(rows[4].force.z(), F, 1e-6 * F);
+    for (int k = 0; k < 4; ++k) {
+        EXPECT_NEAR(rows[k].force.z(), 0, 1e-9 * F) << "roller " << k + 1;
     }
 }
 

@@ -132,6 +132,19 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
             r.kinetic_energy + r.potential_energy);
     }
     m_folder.write("log.csv", csv);
+    if (std::any_of(rows.begin(), rows.end(),
+                    [](const FrameLog& r) { return !r.supports.empty(); })) {
+        std::string supports =
+            "frame,time,solid,constraint,kind,nodes,force_x,force_y,force_z,displacement_x,"
+            "displacement_y,displacement_z\n";
+        for (int f = 0; f < frames(); ++f)
+            for (const SupportLog& l : rows[f].supports)
+                supports += fmt::format(
+                    "{},{:.9g},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f,
+                    rows[f].time, l.solid, l.constraint, l.kind, l.nodes, l.force[0], l.force[1],
+                    l.force[2], l.displacement[0], l.displacement[1], l.displacement[2]);
+        m_folder.write("supports.csv", supports);
+    }
 }
 
 std::vector<int> FrameWriter::write_mesh(const MeshFrame& mesh, int frame, Real time) {

@@ -18,6 +18,17 @@
 
 namespace karst {
 
+/// What one support of a porous solid's Biot problem carries at a frame (a row of supports.csv):
+/// a `fixed` or `platen` constraint, or the static walls that anchor the solid.
+struct SupportLog {
+    Index solid = 0;                   ///< in scene.porous_solids
+    Index constraint = -1;             ///< in its constraints; -1: the static walls
+    std::string kind{};                ///< fixed, platen or walls
+    Index nodes = 0;                   ///< mesh nodes it holds
+    Vec3 force = Vec3::Zero();         ///< on the solid, N (a platen: its applied force)
+    Vec3 displacement = Vec3::Zero();  ///< mean displacement of its nodes, m
+};
+
 /// One row of log.csv.
 struct FrameLog {
     Real time = 0;              ///< s
@@ -31,6 +42,8 @@ struct FrameLog {
     Index removed = 0;          ///< fluid particles that left the domain so far
     Real speed_p99 = 0;         ///< 99th percentile of the fluid particles' speed, m/s
     Real max_speed = 0;         ///< fastest fluid particle, m/s
+    std::vector<SupportLog>
+        supports{};  ///< supports.csv rows of this frame (solids' Biot problems)
 };
 
 /// The PFEM meshes of a frame, as one tetrahedral grid with its point arrays.

@@ -8,6 +8,7 @@
 #include "karst/pfem/porosity.hpp"
 
 #include <algorithm>
+#include <array>
 
 namespace karst {
 
@@ -92,6 +93,57 @@ int platen_axis(const Constraint& c) {
 }
 
 }  // namespace
+
+std::vector<SupportLog> support_loads(const Model& model, const PorousSolid& solid,
+                                      const TetMesh& mesh, const BiotFields& fields,
+                                      const std::vector<Vec3>& support_force, Real time) {
+    const Index n = mesh.node_count();
+    const Index walls = Index(solid.constraints.size());
+    // Per node and axis, the support that holds that component (-1: none).
+    std::vector<std::array<Index, 3>> owner(n, {-1, -1, -1});
+    for (Index k = 0; k < walls; ++k) {
+        const Constraint& c = solid.constraints[k];
+        if (c.kind == Constraint::Kind::Platen)
+            for (Index a : platen_nodes(model, c, mesh)) owner[a][platen_axis(c)] = k;
+        if (c.kind == Constraint::Kind::Fixed)
+            for (Index a = 0; a < n; ++a)
+                if (on_region(model, c, mesh.nodes[a]))
+                    for (int d = 0; d < 3; ++d)
+                        if (c.axes & (1 << d)) owner[a][d] = k;
+    }
+    for (Index a = 0; a < n; ++a)
+        if (touches_wall(model, mesh.nodes[a])) owner[a] = {walls, walls, walls};
+    std::vector<SupportLog> logs(walls + 1);
+    const bool forces = support_force.size() == size_t(n);
+    for (Index a = 0; a < n; ++a) {
+        for (int d = 0; d < 3; ++d)
+            if (owner[a][d] >= 0 && forces) logs[owner[a][d]].force[d] += support_force[a][d];
+        for (int d = 0; d < 3; ++d) {
+            const Index k = owner[a][d];
+            if (k < 0 || (d > 0 && owner[a][0] == k) || (d > 1 && owner[a][1] == k)) continue;
+            ++logs[k].nodes;  // once per node and support
+            logs[k].displacement += fields.u[a];
+        }
+    }
+    std::vector<SupportLog> out;
+    for (Index k = 0; k <= walls; ++k) {
+        SupportLog& l = logs[k];
+        if (l.nodes > 0) l.displacement /= Real(l.nodes);
+        if (k == walls) {
+            if (l.nodes == 0) continue;
+            l.constraint = -1, l.kind = "walls";
+        } else {
+            const Constraint& c = solid.constraints[k];
+            if (c.kind != Constraint::Kind::Fixed && c.kind != Constraint::Kind::Platen) continue;
+            l.constraint = k;
+            l.kind = c.kind == Constraint::Kind::Fixed ? "fixed" : "platen";
+            if (c.kind == Constraint::Kind::Platen)
+                l.force[platen_axis(c)] = c.table.at(time) * c.force;
+        }
+        out.push_back(std::move(l));
+    }
+    return out;
+}
 
 BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                                Real time) {

@@ -35,6 +35,17 @@ struct BoundaryValues {
 BoundaryValues boundary_values(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                                Real time);
 
+/// What each support of `solid` carries on `mesh` (io/frame_writer.hpp SupportLog): every `fixed`
+/// and `platen` constraint in scene order, then the static walls where some node touches one.
+/// Each held component of a node belongs to the support whose value boundary_values gives it (a
+/// wall over any constraint, a later constraint over an earlier), so the forces of all supports
+/// add up to the total support force. A fixed support's force sums its components; a platen's is
+/// its applied force at `time`, since its nodes move freely along its axis. Solid indices are
+/// left 0.
+std::vector<SupportLog> support_loads(const Model& model, const PorousSolid& solid,
+                                      const TetMesh& mesh, const BiotFields& fields,
+                                      const std::vector<Vec3>& support_force, Real time);
+
 /// Whether some constraint of the solid changes in time.
 inline bool has_time_table(const PorousSolid& solid) {
     return std::any_of(solid.constraints.begin(), solid.constraints.end(),

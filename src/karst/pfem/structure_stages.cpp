@@ -318,6 +318,35 @@ void append_structure_meshes(const Model& model, State& state, MeshFrame& frame)
     }
 }
 
+std::vector<SupportLog> structure_supports(const Model& model, const State& state, Real time) {
+    std::vector<SupportLog> rows;
+    for (const Structure& s : state.structures.structures) {
+        const PorousSolid& solid = model.scene.porous_solids[s.solid];
+        for (SupportLog& l : support_loads(model, solid, s.mesh, s.fields, s.support_force, time)) {
+            l.solid = s.solid;
+            auto same = std::find_if(rows.begin(), rows.end(), [&](const SupportLog& r) {
+                return r.solid == l.solid && r.constraint == l.constraint;
+            });
+            if (same == rows.end()) {
+                rows.push_back(std::move(l));
+                continue;
+            }
+            const Index nodes = same->nodes + l.nodes;
+            if (nodes > 0)
+                same->displacement =
+                    (Real(same->nodes) * same->displacement + Real(l.nodes) * l.displacement) /
+                    Real(nodes);
+            if (l.kind != "platen") same->force += l.force;  // a platen's force is its own
+            same->nodes = nodes;
+        }
+    }
+    std::sort(rows.begin(), rows.end(), [](const SupportLog& a, const SupportLog& b) {
+        return std::pair(a.solid, a.constraint < 0 ? Index(1) << 40 : a.constraint) <
+               std::pair(b.solid, b.constraint < 0 ? Index(1) << 40 : b.constraint);
+    });
+    return rows;
+}
+
 MeshQuality structure_mesh_quality(const State& state) {
     MeshQuality q;
     for (const Structure& s : state.structures.structures) {

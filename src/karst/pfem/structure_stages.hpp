@@ -62,6 +62,10 @@ bool feed_back_structures(const Model& model, State& state);
 /// Appends every structure's mesh and fields (nodes at their rest positions X) to `frame`.
 void append_structure_meshes(const Model& model, State& state, MeshFrame& frame);
 
+/// Every solid's supports over its structures (biot_setup.hpp support_loads), one row per solid
+/// and support: forces and node counts summed, displacements averaged over the nodes.
+std::vector<SupportLog> structure_supports(const Model& model, const State& state, Real time);
+
 /// Elements and mesh-quality figures summed over the structures.
 MeshQuality structure_mesh_quality(const State& state);
 

@@ -100,9 +100,14 @@ void fields(Ar& ar, State& s) {
 }
 
 template <class Ar>
+void fields(Ar& ar, SupportLog& l) {
+    ar(l.solid, l.constraint, l.kind, l.nodes, l.force, l.displacement);
+}
+
+template <class Ar>
 void fields(Ar& ar, FrameLog& l) {
     ar(l.time, l.dt, l.steps, l.particles, l.density_error, l.mipps, l.kinetic_energy,
-       l.potential_energy, l.removed, l.speed_p99, l.max_speed);
+       l.potential_energy, l.removed, l.speed_p99, l.max_speed, l.supports);
 }
 
 template <class Ar>

@@ -287,7 +287,10 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         PointSet porous_points;
         if (porous) porous_points = porous_frame(model, state);
         MeshFrame mesh;
-        if (meshes) append_structure_meshes(model, state, mesh);
+        if (meshes) {
+            append_structure_meshes(model, state, mesh);
+            log.supports = structure_supports(model, state, state.time);
+        }
         const CrackFrame cracks = crack_frame(state.structures.cracks);
         const OutputSettings& o = scene.output;
         SurfaceMesh fluid_surface, porous_surface;
