@@ -63,7 +63,8 @@ bool feed_back_structures(const Model& model, State& state);
 void append_structure_meshes(const Model& model, State& state, MeshFrame& frame);
 
 /// Every solid's supports over its structures (biot_setup.hpp support_loads), one row per solid
-/// and support: forces and node counts summed, displacements averaged over the nodes.
+/// and support: forces and node counts summed, displacements averaged over the nodes. `time` is
+/// that of the last Biot call (a platen's applied force).
 std::vector<SupportLog> structure_supports(const Model& model, const State& state, Real time);
 
 /// Elements and mesh-quality figures summed over the structures.

@@ -289,7 +289,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         MeshFrame mesh;
         if (meshes) {
             append_structure_meshes(model, state, mesh);
-            log.supports = structure_supports(model, state, state.time);
+            log.supports = structure_supports(model, state, state.time - state.structures.elapsed);
         }
         const CrackFrame cracks = crack_frame(state.structures.cracks);
         const OutputSettings& o = scene.output;
