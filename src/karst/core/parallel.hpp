@@ -31,12 +31,17 @@ T deterministic_reduce(Index n, T identity, const F& f, const Combine& combine) 
     constexpr Index block = 4096;
     const Index blocks = (n + block - 1) / block;
     std::vector<T> partial(static_cast<size_t>(blocks), identity);
-    parallel_for(blocks, [&](Index b) {
-        T acc = identity;
-        for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
-            acc = combine(acc, f(i));
-        partial[b] = acc;
-    });
+    // One task per block (grain 1): parallel_for's grain would keep a few dozen blocks on one
+    // thread.
+    tbb::parallel_for(
+        tbb::blocked_range<Index>(0, blocks, 1), [&](const tbb::blocked_range<Index>& r) {
+            for (Index b = r.begin(); b != r.end(); ++b) {
+                T acc = identity;
+                for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+                    acc = combine(acc, f(i));
+                partial[b] = acc;
+            }
+        });
     T acc = identity;
     for (const T& p : partial) acc = combine(acc, p);
     return acc;

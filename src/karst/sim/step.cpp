@@ -22,6 +22,7 @@
 #include "karst/sph/integrate.hpp"
 #include "karst/sph/non_pressure_forces.hpp"
 #include "karst/sph/pcisph.hpp"
+#include "karst/sph/pressure_acceleration.hpp"
 #include "karst/sph/solute_diffusion.hpp"
 
 #include <fmt/format.h>
@@ -152,10 +153,12 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         if (porous) update_porous_neighbours(model, state);
     });
 
-    // 2. Akinci volumes of the porous particles (§4.1), fluid densities with the boundary (M7).
+    // 2. Akinci volumes of the porous particles (§4.1), fluid densities with the boundary (M7),
+    //    and the per-pair kernel gradient factors that the forces and the pressure solve share.
     timed(profile, Stage::Density, [&] {
         if (porous) update_porous_boundary_volumes(model, state);
         update_density(model, state);
+        pressure_pair_coefficients(model, state);
     });
     check_scalars(state.fluid.rho, id, Stage::Density, t, "density");
 

@@ -93,15 +93,15 @@ SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& 
             a_out[i] = pressure_acceleration(model, state, p, i, boundary);
             s.v_pred[i] = base[i] + dt * a_out[i];
         });
-        parallel_for(n, [&](Index i) {
-            s.rho_err[i] = f.rho[i] + density_change(model, state, s.v_pred, i, dt) - target(i);
-        });
         // The complementarity residual: compression where p_i = 0 is allowed to rise, and as much
         // over-pressure as p_i could give back where the fluid expands. A warm start that pushes
         // the fluid apart is thus corrected, not accepted because nothing is compressed.
         r.max_error = parallel_max(n, 0.0,
                                    [&](Index i) {
-                                       const Real e = s.rho_err[i];
+                                       const Real e = s.rho_err[i] =
+                                           f.rho[i] +
+                                           density_change(model, state, s.v_pred, i, dt) -
+                                           target(i);
                                        return e > 0 ? e : std::min(-e, s.diagonal[i] * p[i]);
                                    }) /
                       model.rho0;
@@ -124,7 +124,6 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     const Index n = f.size();
     const FluidSettings& fs = model.scene.fluid;
     const Real rho0 = model.rho0;
-    pressure_pair_coefficients(model, state);
     compute_diagonal(model, state, dt);
     s.v_pred.resize(n), s.rho_err.resize(n), s.a_divergence.resize(n), s.a_pressure.resize(n);
 

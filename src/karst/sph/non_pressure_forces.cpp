@@ -38,19 +38,23 @@ void compute_non_pressure_forces(const Model& model, State& state) {
     // Becker & Teschner 2007: Pi_ij = -nu_a min(v_ij.x_ij, 0) / (r^2 + 0.01 h^2) with
     // nu_a = 2 alpha_v h c_s / (rho_i + rho_j); a_i = -sum_j m_j Pi_ij grad W_ij.
     const Real artificial = 2 * fs.artificial_viscosity * h * fs.sound_speed;
+    const Real rho0_2 = rho0 * rho0;
+    const int cap_f = s.fluid_fluid.capacity;
     s.a_other.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i], vi = f.v[i];
         const Real rho_i = f.rho[i];
         Vec3 a = Vec3::Zero();
+        // m_j grad W_ij from the step's pair factors (pressure_acceleration.hpp).
+        const Real* cf = s.pair_coefficient.data() + i * cap_f;
+        int k = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
             const Vec3 xij = xi - f.x[j];
             const Real r2 = xij.squaredNorm();
-            const Vec3 grad = xij * W.dw_over_r(std::sqrt(r2));
+            const Vec3 m_grad = (rho0_2 * cf[k++]) * xij;
             const Real vx = (vi - f.v[j]).dot(xij);
-            a += (visc * f.sph_mass[j] * (1 / rho_i + 1 / f.rho[j]) * vx / (r2 + eps)) * grad;
-            if (vx < 0)
-                a += (artificial / (rho_i + f.rho[j]) * f.sph_mass[j] * vx / (r2 + eps)) * grad;
+            a += (visc * (1 / rho_i + 1 / f.rho[j]) * vx / (r2 + eps)) * m_grad;
+            if (vx < 0) a += (artificial / (rho_i + f.rho[j]) * vx / (r2 + eps)) * m_grad;
             if (tension) {
                 // Akinci 2013: K_ij (cohesion + curvature), per unit mass of i.
                 const Real r = std::sqrt(r2);

@@ -88,7 +88,6 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     s.x_pred.resize(n);
     s.rho_err.resize(n);
     compute_delta(model, state, dt, s.delta);
-    pressure_pair_coefficients(model, state);
     s.a_pressure.assign(n, Vec3::Zero());
     parallel_for(n, [&](Index i) { s.x_pred[i] = f.x[i] + dt * (f.v[i] + dt * s.a_other[i]); });
 
