@@ -15,10 +15,11 @@ namespace karst {
 /// Grain of the parallel loops: large enough to hide scheduling cost for SPH-sized work.
 inline constexpr Index k_parallel_grain = 256;
 
-/// Calls body(i) for i in [0, n), in parallel. body must write only data owned by index i.
+/// Calls body(i) for i in [0, n), in parallel, at least `grain` indices per task. body must write
+/// only data owned by index i.
 template <class Body>
-void parallel_for(Index n, const Body& body) {
-    tbb::parallel_for(tbb::blocked_range<Index>(0, n, k_parallel_grain),
+void parallel_for(Index n, const Body& body, Index grain = k_parallel_grain) {
+    tbb::parallel_for(tbb::blocked_range<Index>(0, n, grain),
                       [&](const tbb::blocked_range<Index>& r) {
                           for (Index i = r.begin(); i != r.end(); ++i) body(i);
                       });
@@ -31,17 +32,16 @@ T deterministic_reduce(Index n, T identity, const F& f, const Combine& combine) 
     constexpr Index block = 4096;
     const Index blocks = (n + block - 1) / block;
     std::vector<T> partial(static_cast<size_t>(blocks), identity);
-    // One task per block (grain 1): parallel_for's grain would keep a few dozen blocks on one
-    // thread.
-    tbb::parallel_for(
-        tbb::blocked_range<Index>(0, blocks, 1), [&](const tbb::blocked_range<Index>& r) {
-            for (Index b = r.begin(); b != r.end(); ++b) {
-                T acc = identity;
-                for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
-                    acc = combine(acc, f(i));
-                partial[b] = acc;
-            }
-        });
+    // One task per block: the default grain would keep a few dozen blocks on one thread.
+    parallel_for(
+        blocks,
+        [&](Index b) {
+            T acc = identity;
+            for (Index i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+                acc = combine(acc, f(i));
+            partial[b] = acc;
+        },
+        1);
     T acc = identity;
     for (const T& p : partial) acc = combine(acc, p);
     return acc;
