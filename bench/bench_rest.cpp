@@ -81,7 +81,8 @@ Index top_layer_size(const Model& model, const FluidParticles& f) {
 /// the top two layers; the surface is the mean height of the `top_layer` highest particles plus
 /// dx / 2.
 Real hydrostatic_l2(const Model& model, const FluidParticles& f, Index top_layer) {
-    std::vector<Real> h = heights(model, f);
+    const std::vector<Real> z = heights(model, f);
+    std::vector<Real> h = z;
     const Index n = std::min(top_layer, Index(h.size()));
     if (n == 0) return std::numeric_limits<Real>::quiet_NaN();
     std::partial_sort(h.begin(), h.begin() + n, h.end(), std::greater<>());
@@ -93,7 +94,6 @@ Real hydrostatic_l2(const Model& model, const FluidParticles& f, Index top_layer
         int n = 0;
     };
     std::map<long, Row> rows;
-    const std::vector<Real> z = heights(model, f);
     for (Index i = 0; i < f.size(); ++i) {
         Row& r = rows[std::lround(std::floor(z[i] / model.dx))];
         r.p += f.pressure(i), r.h += z[i], ++r.n;
@@ -149,8 +149,8 @@ int main(int argc, char** argv) {
             const std::string key = argv[a];
             if (a + 1 == argc) throw std::invalid_argument(key + " needs a value");
             const std::string value = argv[a + 1];
-            size_t used = 0;
             auto number = [&] {
+                size_t used = 0;
                 const double x = std::stod(value, &used);
                 if (used != value.size()) throw std::invalid_argument(key + ": " + value);
                 return x;
