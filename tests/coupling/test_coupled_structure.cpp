@@ -135,13 +135,14 @@ TEST(CoupledStructure, AJellySoftBlockDistortsItsMeshAndIsRemeshedOnItsDeformedS
     while (sim.state.time < 0.3 - 1e-9) step(sim.model, sim.state, 0.002, sim.profile);
     EXPECT_GE(sim.state.structures.timings.remeshes, 1);
     // The remeshes carry the deformation on: the top has sunk by over a quarter of a spacing, and
-    // no particle left the tank or the block's footprint.
+    // no particle left the tank (the block fills its footprint). Before members stopped at the
+    // walls, a top member held by slivers of the first remesh was carried 7 cm down in one call,
+    // through the floor.
     EXPECT_LT(mean_sinking(sim.state.porous.particles, rest, 0.05 - 1e-9), -0.25 * dx);
     for (const Vec3& x : sim.state.porous.particles.x) {
         ASSERT_TRUE(x.allFinite());
-        EXPECT_GT(x[2], -0.5 * dx);
-        EXPECT_GT(x.head<2>().minCoeff(), -0.5 * dx);
-        EXPECT_LT(x.head<2>().maxCoeff(), 0.4 + 0.5 * dx);
+        EXPECT_GT(x.minCoeff(), 0);
+        EXPECT_LT(x.head<2>().maxCoeff(), 0.4);
     }
     EXPECT_EQ(sim.state.porous.particles.size(), Index(rest.size()));
 }

@@ -3,6 +3,7 @@
 #include "karst/core/parallel.hpp"
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/face_links.hpp"
+#include "karst/scene/wall_crossing.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -171,6 +172,9 @@ void follow_structure_displacement(const Model& model, State& state) {
         const Vec3 change = s.fields.u[a] - s.u_from[a];
         p.x[i] = st.rest_x[p.id[i]] + s.u_from[a] + fraction * change;
         p.v[i] = fraction < 1 ? Vec3(change / dt_B) : Vec3::Zero();
+        // [D] Biot has no contact with the walls: a displacement over a spacing (a very soft or
+        // badly connected member) can carry a member through one. It stops at the wall instead.
+        push_back_through_walls(model.scene.walls, model.dx, p.x[i], p.v[i]);
     });
 }
 
@@ -200,8 +204,14 @@ void remesh_structures(const Model& model, State& state) {
             // [D] A distorted mesh is rebuilt on the deformed positions, which become the new
             // rest state (u = 0 there): small-strain Biot cannot carry a deformation that inverts
             // elements, so the stress it held is released, as in a soil that has flowed.
-            for (Index a = 0; a < n; ++a)
-                st.rest_x[s.node_id[a]] += s.fields.u[a], st.u[s.node_id[a]] = Vec3::Zero();
+            // Where a wall stopped a member (follow_structure_displacement), the rest state is
+            // where it stopped.
+            for (Index a = 0; a < n; ++a) {
+                const Index id = s.node_id[a], i = index_of[id];
+                st.rest_x[id] =
+                    i >= 0 ? state.porous.particles.x[i] : st.rest_x[id] + s.fields.u[a];
+                st.u[id] = Vec3::Zero();
+            }
         } else {
             continue;
         }

@@ -1,51 +1,12 @@
 #include "karst/sph/integrate.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/scene/wall_crossing.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace karst {
-
-namespace {
-
-/// How far a particle pushed back through a wall lands inside its surface, in spacings: the
-/// fluid lattice starts half a spacing inside, so a quarter keeps it clear of the wall skin.
-constexpr Real k_push_back_depth = 0.25;
-
-/// The outward normal of a wall's fluid side at x: the gradient of the signed distance of the
-/// region the fluid may not enter (central differences; unit length or zero).
-Vec3 outward_normal(const Wall& wall, const Vec3& x, Real step) {
-    const Real sign = wall.kind == Wall::Kind::Container ? 1 : -1;
-    Vec3 g;
-    for (int d = 0; d < 3; ++d) {
-        Vec3 e = Vec3::Zero();
-        e[d] = step;
-        g[d] = sign * (wall.shape.signed_distance(x + e) - wall.shape.signed_distance(x - e));
-    }
-    const Real norm = g.norm();
-    return norm > 0 ? Vec3(g / norm) : Vec3::Zero();
-}
-
-/// A fluid particle that crossed a wall's surface in this step (a container's cavity left, an
-/// obstacle entered) is put back a quarter spacing inside and loses its outward normal velocity,
-/// an inelastic contact that cannot add energy. Returns whether it was.
-bool push_back_through_walls(const Model& model, Vec3& x, Vec3& v) {
-    bool pushed = false;
-    for (const Wall& wall : model.scene.walls) {
-        const Real d = wall.shape.signed_distance(x);
-        const Real outside =
-            wall.kind == Wall::Kind::Container ? d : -d;  // > 0: on the wall's side
-        if (!(outside > 0)) continue;
-        const Vec3 n = outward_normal(wall, x, 0.1 * model.dx);
-        x -= (outside + k_push_back_depth * model.dx) * n;
-        v -= std::max(v.dot(n), Real(0)) * n;
-        pushed = true;
-    }
-    return pushed;
-}
-
-}  // namespace
 
 Real integrate_fluid(const Model& model, State& state, Real dt) {
     FluidParticles& f = state.fluid;
@@ -56,7 +17,7 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
     parallel_for(n, [&](Index i) {
         f.v[i] += dt * (s.a_other[i] + s.a_pressure[i]);
         f.x[i] += dt * f.v[i];
-        pushed[i] = push_back_through_walls(model, f.x[i], f.v[i]);
+        pushed[i] = push_back_through_walls(model.scene.walls, model.dx, f.x[i], f.v[i]);
         // Particles drained into the porous solid (mass 0, porous/drained_fluid.hpp) go too.
         const bool inside = model.domain.contains(f.x[i]);
         escaped[i] = !inside && f.mass[i] > 0;
