@@ -39,28 +39,29 @@ using namespace karst;
 
 namespace {
 
-const std::map<std::string, std::string> k_scenes = {
-    {"column", R"({
-      "name": "rest_column", "particle_spacing": 0.01,
-      "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.08, 0.08, 1.0] } } ],
-      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.08, 0.08, 1.2] } } ]
-    })"},
-    {"narrow_tank", R"({
-      "name": "rest_narrow_tank", "particle_spacing": 0.01,
-      "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.04, 0.04, 0.2] } } ],
-      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.04, 0.04, 0.3] } } ]
-    })"},
-    {"column_60cm", R"({
-      "name": "rest_column_60cm", "particle_spacing": 0.02, "fluid": { "artificial_viscosity": 0.02 },
-      "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.08, 0.08, 0.6] } } ],
-      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.08, 0.08, 0.8] } } ]
-    })"},
-    {"column_80cm", R"({
-      "name": "rest_column_80cm", "particle_spacing": 0.02,
-      "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.08, 0.08, 0.8] } } ],
-      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.08, 0.08, 1.0] } } ]
-    })"},
-    {"l_tank", R"({
+/// Water `depth` deep at spacing dx filling a square `width` x `width` closed box `height` tall.
+nlohmann::json water_column(const std::string& name, Real dx, Real width, Real depth, Real height) {
+    auto box = [](Real w, Real h) {
+        return nlohmann::json{{"type", "box"}, {"min", {0, 0, 0}}, {"max", {w, w, h}}};
+    };
+    return {{"name", "rest_" + name},
+            {"particle_spacing", dx},
+            {"fluid_blocks", {{{"shape", box(width, depth)}}}},
+            {"walls", {{{"kind", "container"}, {"shape", box(width, height)}}}}};
+}
+
+/// `scene` with its fluid's artificial viscosity set (the issue's 0.6 m column used 0.02).
+nlohmann::json column_with_viscosity(nlohmann::json scene, Real artificial_viscosity) {
+    scene["fluid"]["artificial_viscosity"] = artificial_viscosity;
+    return scene;
+}
+
+const std::map<std::string, nlohmann::json> k_scenes = {
+    {"column", water_column("column", 0.01, 0.08, 1.0, 1.2)},
+    {"narrow_tank", water_column("narrow_tank", 0.01, 0.04, 0.2, 0.3)},
+    {"column_60cm", column_with_viscosity(water_column("column_60cm", 0.02, 0.08, 0.6, 0.8), 0.02)},
+    {"column_80cm", water_column("column_80cm", 0.02, 0.08, 0.8, 1.0)},
+    {"l_tank", nlohmann::json::parse(R"({
       "name": "rest_l_tank", "particle_spacing": 0.01,
       "fluid_blocks": [
         { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.15, 0.1, 0.3] } },
@@ -68,7 +69,7 @@ const std::map<std::string, std::string> k_scenes = {
       "walls": [
         { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.3, 0.1, 0.4] } },
         { "kind": "obstacle", "shape": { "type": "box", "min": [0.15, 0, 0], "max": [0.3, 0.1, 0.15] } } ]
-    })"},
+    })")},
 };
 
 struct Settings {
@@ -125,7 +126,7 @@ Real hydrostatic_l2(const Model& model, const FluidParticles& f, Index top_layer
 }
 
 void run(const std::string& name, const std::string& solver, const Settings& settings) {
-    nlohmann::json json = nlohmann::json::parse(k_scenes.at(name));
+    nlohmann::json json = k_scenes.at(name);
     json["fluid"]["solver"] = solver;
     if (settings.dt_max > 0) json["time"]["dt_max"] = settings.dt_max;
     if (settings.tolerance > 0) json["fluid"]["max_density_error"] = settings.tolerance;

@@ -6,7 +6,7 @@ namespace karst {
 
 namespace {
 
-/// The outward normal of a wall's fluid side at x: the gradient of the signed distance of the
+/// The outward normal of a wall's open side at x: the gradient of the signed distance of the
 /// region a particle may not enter (central differences; unit length or zero).
 Vec3 outward_normal(const Wall& wall, const Vec3& x, Real step) {
     const Real sign = wall.kind == Wall::Kind::Container ? 1 : -1;
