@@ -93,11 +93,26 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     std::vector<Index> links_broken(cracks.size(), 0);
     std::vector<char> cut(cutter.size(), 0);
     for (size_t k = 0; k < cutter.size(); ++k) cut[k] = cutter[k] >= 0;
-    spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets);
+    // A small piece whose fixed nodes hold it stays in the structure (the topology below): it is
+    // no fragment, and sparing it left a body hanging from a stub by links no crack could cut.
+    const auto stays_anchored = [&](std::span<const Index> tets) {
+        std::vector<Vec3> held_x;
+        std::vector<std::uint8_t> held_axes;
+        std::vector<Index> nodes;
+        for (Index e : tets)
+            for (Index a : s.mesh.tets[e])
+                if (problem.fixed[a]) nodes.push_back(a);
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        for (Index a : nodes)
+            held_x.push_back(s.mesh.nodes[a]), held_axes.push_back(problem.fixed[a]);
+        return holds_rigid_modes(held_x, held_axes);
+    };
+    spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets, stays_anchored);
     // §5.1.3's sliver volume, 1e-3 h_e^3 with h_e = dx.
     cut_sliver_bridges(s.mesh, s.links, cut, 1e-3 * std::pow(model.dx, 3));
     // Last, so that no cut above leaves a piece under the resolution.
-    spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets);
+    spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets, stays_anchored);
     for (size_t k = 0; k < cutter.size(); ++k)
         if (cut[k] && cutter[k] >= 0) ++links_broken[cutter[k]];
     const Index broken = Index(std::count(cut.begin(), cut.end(), 1));

@@ -205,18 +205,25 @@ Index cut_sliver_bridges(const TetMesh& mesh, std::span<const ElementLink> links
 }
 
 Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
-                         std::vector<char>& cut, Index min_tets) {
+                         std::vector<char>& cut, Index min_tets,
+                         const std::function<bool(std::span<const Index>)>& stays_anchored) {
     Index restored = 0;
     for (bool changed = true; changed;) {
         changed = false;
         DisjointSets sets(tet_count);
         for (size_t k = 0; k < links.size(); ++k)
             if (!cut[k]) sets.join(links[k].a, links[k].b);
-        std::vector<Index> size(tet_count, 0);
-        for (Index e = 0; e < tet_count; ++e) ++size[sets.find(e)];
+        std::vector<std::vector<Index>> pieces(tet_count);
+        for (Index e = 0; e < tet_count; ++e) pieces[sets.find(e)].push_back(e);
+        // 1: a piece under the resolution, whose cuts are restored.
+        std::vector<char> small(tet_count, 0);
+        for (Index root = 0; root < tet_count; ++root) {
+            const std::vector<Index>& piece = pieces[root];
+            small[root] = !piece.empty() && Index(piece.size()) < min_tets &&
+                          !(stays_anchored && stays_anchored(piece));
+        }
         for (size_t k = 0; k < links.size(); ++k)
-            if (cut[k] &&
-                (size[sets.find(links[k].a)] < min_tets || size[sets.find(links[k].b)] < min_tets))
+            if (cut[k] && (small[sets.find(links[k].a)] || small[sets.find(links[k].b)]))
                 cut[k] = 0, ++restored, changed = true;
     }
     return restored;

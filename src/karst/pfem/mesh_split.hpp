@@ -4,6 +4,7 @@
 // with the `source` and `share` arrays.
 #include "karst/pfem/structure_state.hpp"
 
+#include <functional>
 #include <span>
 
 namespace karst {
@@ -40,9 +41,12 @@ Index cut_sliver_bridges(const TetMesh& mesh, std::span<const ElementLink> links
 
 /// Restores cut links around every piece of fewer than `min_tets` tets that the cuts would make,
 /// until none is left: a crack does not chip off pieces below the mesh's resolution (they would
-/// be rigid fragments of a few particles). Returns the number of links restored.
+/// be rigid fragments of a few particles). A small piece for which `stays_anchored(its tets)`
+/// holds becomes no fragment and is left cut, so that a body hanging from a small anchored stub
+/// can break off it. Returns the number of links restored.
 Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
-                         std::vector<char>& cut, Index min_tets);
+                         std::vector<char>& cut, Index min_tets,
+                         const std::function<bool(std::span<const Index>)>& stays_anchored = {});
 
 /// The tets with keep[e] set, on their nodes (renumbered in input order), and with
 /// `keep_loose_nodes` the nodes that belong to no tet: `node_of` gets, per node of the result,

@@ -4,6 +4,8 @@
 #include "karst/core/soa.hpp"
 #include "karst/rigid/contact.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 
 namespace karst {
@@ -36,37 +38,74 @@ ContactLaw fragment_contact_law(const Model& model, const State& state) {
     return ContactLaw::for_fragments(model.dx, lightest, g, 2 * lightest);
 }
 
-}  // namespace
+/// The highest contact frequency of the free fragments, rad/s: per fragment the largest
+/// eigenvalue of M6^-1 K6, K6 = sum_pairs k [n; r x n][n; r x n]^T over its touching pairs (r from
+/// its centre, n along the pair), M6 = diag(M I, I_w). A pair between two free fragments counts
+/// twice (their reduced mass is at most half of either).
+Real contact_frequency(const Model& model, const State& state, const ContactLaw& law) {
+    using Mat6 = Eigen::Matrix<Real, 6, 6>;
+    using Vec6 = Eigen::Matrix<Real, 6, 1>;
+    const PorousParticles& p = state.porous.particles;
+    const std::vector<Fragment>& fragments = state.porous.fragments;
+    const PorousScratch& s = state.porous_scratch;
+    auto is_free = [&](Index f) { return !fragments[f].anchored && fragments[f].mass > 0; };
+    std::vector<Mat6> stiffness(fragments.size(), Mat6::Zero());
+    std::vector<char> touching(fragments.size(), 0);
+    auto add = [&](Index k, const Vec3& x, Real weight) {
+        const Index f = p.fragment[k];
+        const Real r = x.norm();
+        if (r >= law.rest_distance || r == 0) return;
+        Vec6 j;
+        j << x / r, (p.x[k] - fragments[f].centre).cross(x / r);
+        stiffness[f] += (weight * law.stiffness) * j * j.transpose();
+        touching[f] = 1;
+    };
+    for (Index k = 0; k < p.size(); ++k) {  // serial: a few pairs per touching member
+        if (!is_free(p.fragment[k])) continue;
+        s.porous_porous.for_each(k, [&](Index j) {
+            if (p.fragment[j] == p.fragment[k] || p.origin[j] == p.origin[k]) return;
+            add(k, p.x[k] - p.x[j], is_free(p.fragment[j]) ? 2 : 1);
+        });
+        s.porous_wall.for_each(k, [&](Index w) { add(k, p.x[k] - model.walls.x[w], 1); });
+    }
+    Real highest = 0;
+    for (size_t f = 0; f < fragments.size(); ++f) {
+        if (!touching[f]) continue;
+        Mat6 mass = Mat6::Zero();
+        mass.topLeftCorner<3, 3>() = fragments[f].mass * Mat3::Identity();
+        mass.bottomRightCorner<3, 3>() = fragments[f].world_inertia();
+        const Eigen::GeneralizedSelfAdjointEigenSolver<Mat6> modes(stiffness[f], mass,
+                                                                   Eigen::EigenvaluesOnly);
+        highest = std::max(highest, std::sqrt(std::max(modes.eigenvalues().maxCoeff(), Real(0))));
+    }
+    return highest;
+}
 
-void advance_fragments(const Model& model, State& state, Real dt) {
+/// Largest omega h of a contact sub-step: explicit springs are stable below 2.
+constexpr Real k_contact_step = 1.5;
+
+/// Every free fragment moves as a rigid body under `force` (per member), `torque` and gravity
+/// over h, and its members follow: x = c + R X, v = v_c + omega x (x - c), K = R K0 R^T.
+void move_fragments(const Model& model, State& state, const std::vector<Vec3>& force, Real h) {
     PorousParticles& p = state.porous.particles;
     std::vector<Fragment>& fragments = state.porous.fragments;
-    PorousScratch& s = state.porous_scratch;
-    const ContactLaw law = fragment_contact_law(model, state);
-    s.contacts = 0;
-    if (law.stiffness > 0) {
-        s.contacts += add_contact_forces(p, s.porous_porous, law, s.force);
-        s.contacts += add_wall_contact_forces(p, s.porous_wall, model.walls.x, law, s.force);
-    }
-
     // F_r = sum_k F_k + M g, tau_r = sum_k (x_k - c) x F_k (§4.5), summed in particle order.
     const size_t nf = fragments.size();
-    std::vector<Vec3> force(nf, Vec3::Zero()), torque(nf, Vec3::Zero());
+    std::vector<Vec3> total(nf, Vec3::Zero()), torque(nf, Vec3::Zero());
     for (Index k = 0; k < p.size(); ++k) {
         const Index f = p.fragment[k];
-        force[f] += s.force[k];
-        torque[f] += (p.x[k] - fragments[f].centre).cross(s.force[k]);
+        total[f] += force[k];
+        torque[f] += (p.x[k] - fragments[f].centre).cross(force[k]);
     }
     std::vector<Mat3> rotation(nf);
     std::vector<Vec3> omega(nf);
     for (size_t f = 0; f < nf; ++f) {
         Fragment& fr = fragments[f];
         if (fr.mass > 0 && !fr.anchored)
-            integrate_fragment(fr, force[f] + fr.mass * model.scene.gravity, torque[f], dt);
+            integrate_fragment(fr, total[f] + fr.mass * model.scene.gravity, torque[f], h);
         rotation[f] = fr.rotation_matrix();
         omega[f] = fr.mass > 0 ? fr.angular_velocity() : Vec3::Zero();
     }
-    std::vector<char> inside(p.size(), 1);
     parallel_for(p.size(), [&](Index k) {
         const Index f = p.fragment[k];
         const Fragment& fr = fragments[f];
@@ -75,7 +114,40 @@ void advance_fragments(const Model& model, State& state, Real dt) {
         p.x[k] = fr.centre + R * p.rest[k];
         p.v[k] = fr.velocity + omega[f].cross(p.x[k] - fr.centre);
         p.permeability[k] = R * p.body_permeability[k] * R.transpose();
-        inside[k] = model.domain.contains(p.x[k]);
+    });
+}
+
+}  // namespace
+
+void advance_fragments(const Model& model, State& state, Real dt) {
+    PorousParticles& p = state.porous.particles;
+    PorousScratch& s = state.porous_scratch;
+    const ContactLaw law = fragment_contact_law(model, state);
+    s.contacts = 0;
+    if (law.stiffness == 0) {
+        move_fragments(model, state, s.force, dt);
+    } else {
+        // [D] The springs are explicit: a light fragment pressed between others rang up and
+        // flew off with energy it never had, so the contacts take sub-steps short enough for
+        // the stiffest contact mode, under the step's fixed fluid reactions.
+        const int substeps =
+            std::max(1, int(std::ceil(dt * contact_frequency(model, state, law) / k_contact_step)));
+        const Real h = dt / substeps;
+        const std::vector<Vec3> fluid = s.force;
+        std::vector<Vec3> force(p.size()), mean(p.size(), Vec3::Zero());
+        for (int sub = 0; sub < substeps; ++sub) {
+            force = fluid;
+            Index touching = add_contact_forces(p, s.porous_porous, law, force);
+            touching += add_wall_contact_forces(p, s.porous_wall, model.walls.x, law, force);
+            if (sub == 0) s.contacts = touching;
+            move_fragments(model, state, force, h);
+            for (Index k = 0; k < p.size(); ++k) mean[k] += force[k] / substeps;
+        }
+        s.force = std::move(mean);  // what the members felt on average: the Biot loads
+    }
+    std::vector<char> inside(p.size(), 1);
+    parallel_for(p.size(), [&](Index k) {
+        inside[k] = state.porous.fragments[p.fragment[k]].anchored || model.domain.contains(p.x[k]);
     });
     const Index kept = std::count(inside.begin(), inside.end(), 1);
     if (kept != p.size()) {

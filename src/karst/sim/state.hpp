@@ -37,6 +37,7 @@ struct FluidScratch {
     NeighbourLists fluid_porous;           ///< porous neighbours within h (Akinci boundary, §4.1)
     std::vector<Real> porous_coefficient;  ///< per porous pair: Psi_k / rho0^2 dW/dr / r
     std::vector<Real> porous_hydrostatic;  ///< per porous pair: -rho0 g.x_ik, Pa
+    std::vector<Vec3> porous_v_pred;       ///< per porous particle: its velocity in the solve, m/s
 };
 
 /// Porous particles and their fragments (docs/method.md §2, §4.5): the physical state.

@@ -1,6 +1,7 @@
 #include "karst/sph/dfsph.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/coupling/fragment_response.hpp"
 #include "karst/sph/pressure_acceleration.hpp"
 
 #include <algorithm>
@@ -9,16 +10,24 @@ namespace karst {
 
 namespace {
 
-/// -d rho*_i / d p_i = dt^2 / rho0^2 (g_i.G_i + m_i sum_j m_j |grad W_ij|^2), with
-/// g_i = sum_j m_j grad W_ij + sum_k Psi_k grad W_ik and G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k
-/// grad W_ik (a boundary neighbour carries p_i + p_ik, both rising with p_i). Fixed for the step.
+/// -d rho*_i / d p_i = dt^2 / rho0^2 (|G_i|^2 + m_i sum_j m_j |grad W_ij|^2 + fragments), with
+/// G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik, the gradient of both the predicted density
+/// (density_change) and the pressure force. A free fragment F that p_i pushes away adds
+/// m_i (|B_F|^2 / M_F + T_F.I_F^-1 T_F), B_F = 2 sum_{k in F} Psi_k grad W_ik and T_F = sum_{k in
+/// F} (x_k - c_F) x 2 Psi_k grad W_ik: without it a light fragment took the Jacobi update's
+/// over-shoot, and the solve diverged. Fixed for the step.
 void compute_diagonal(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0, scale = dt * dt / rho0_2;
     const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
               cap_p = s.fluid_porous.capacity;
-    const std::vector<Vec3>& porous_x = state.porous.particles.x;
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Fragment>& fragments = state.porous.fragments;
+    std::vector<Mat3> inverse_inertia(fragments.size(), Mat3::Zero());
+    for (size_t q = 0; q < fragments.size(); ++q)
+        if (!fragments[q].anchored && fragments[q].mass > 0)
+            inverse_inertia[q] = fragments[q].world_inertia().inverse();
     s.diagonal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i];
@@ -37,43 +46,73 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
             i, [&](Index w) { boundary += (rho0_2 * cw[k++]) * (xi - model.walls.x[w]); });
         const Real* cp = s.porous_coefficient.data() + i * cap_p;
         k = 0;
-        s.fluid_porous.for_each(
-            i, [&](Index w) { boundary += (rho0_2 * cp[k++]) * (xi - porous_x[w]); });
+        // The free fragments touched, in list order (a particle touches one or two).
+        Index touched[4];
+        Vec3 push[4], turn[4];
+        int n_touched = 0;
+        s.fluid_porous.for_each(i, [&](Index w) {
+            const Vec3 g = (rho0_2 * cp[k++]) * (xi - porous.x[w]);  // Psi_k grad W_ik
+            boundary += g;
+            const Index q = porous.fragment[w];
+            if (fragments[q].anchored || fragments[q].mass <= 0) return;
+            int slot = 0;
+            while (slot < n_touched && touched[slot] != q) ++slot;
+            if (slot == n_touched) {
+                if (n_touched == 4) return;  // more: the diagonal is a little small
+                touched[slot] = q, push[slot] = turn[slot] = Vec3::Zero(), ++n_touched;
+            }
+            push[slot] += 2 * g;
+            turn[slot] += (porous.x[w] - fragments[q].centre).cross(2 * g);
+        });
+        Real mobility = 0;  // the fragments' share, per unit m_i
+        for (int slot = 0; slot < n_touched; ++slot)
+            mobility += push[slot].squaredNorm() / fragments[touched[slot]].mass +
+                        turn[slot].dot(inverse_inertia[touched[slot]] * turn[slot]);
         // sum_j m_i m_j |grad W_ij|^2, read as (m_i / m_0) sum_j |m_j grad W_ij|^2 (equal for
         // water).
-        const Real own = (fluid + boundary).dot(fluid + 2 * boundary);
-        s.diagonal[i] =
-            scale * (std::max(own, Real(0)) + squares * f.sph_mass[i] / model.particle_mass);
+        const Real own = (fluid + 2 * boundary).squaredNorm();
+        s.diagonal[i] = scale * (own + squares * f.sph_mass[i] / model.particle_mass +
+                                 f.sph_mass[i] * mobility);
     });
 }
 
-/// dt D_i(v) = dt (sum_j m_j (v_i - v_j).grad W_ij + sum_k Psi_k (v_i - v_k).grad W_ik): the
-/// density change that the velocities v would make over dt, kg/m^3.
-Real density_change(const Model& model, const State& state, const std::vector<Vec3>& v, Index i,
-                    Real dt) {
+/// dt D_i(v) = dt (sum_j m_j (v_i - v_j).grad W_ij + 2 sum_k Psi_k (v_i - v_k).grad W_ik): the
+/// density change that the fluid velocities v and the porous members' velocities v_porous would
+/// make over dt, kg/m^3, as the solves predict it.
+/// [D] The boundary counts twice, as in the pressure force, where a boundary neighbour pushes with
+/// p_i + p_ik and p_ik rises with p_i (pressure_acceleration.hpp). The force's part linear in p is
+/// then minus the transpose of this rate, and each solve projects the velocities orthogonally,
+/// which takes kinetic energy away; with the boundary once (the density sum's own rate) the
+/// projection was oblique, and deep water at rest gained energy and never settled
+/// (bench/results/notes.md). Moving boundaries keep this property only with their inertia in
+/// the solve (coupling/fragment_response.hpp). The price: next to a wall the density reaches rho0
+/// over a few steps instead of one.
+Real density_change(const Model& model, const State& state, const std::vector<Vec3>& v,
+                    const std::vector<Vec3>& v_porous, Index i, Real dt) {
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0;
     const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
               cap_p = s.fluid_porous.capacity;
     const Vec3 xi = f.x[i], vi = v[i];
-    Real sum = 0;
+    Real fluid = 0, boundary = 0;
     const Real* cf = s.pair_coefficient.data() + i * cap_f;
     int k = 0;
-    s.fluid_fluid.for_each(i, [&](Index j) { sum += cf[k++] * (vi - v[j]).dot(xi - f.x[j]); });
+    s.fluid_fluid.for_each(i, [&](Index j) { fluid += cf[k++] * (vi - v[j]).dot(xi - f.x[j]); });
     const Real* cw = s.wall_coefficient.data() + i * cap_w;
     k = 0;
-    s.fluid_wall.for_each(i, [&](Index w) { sum += cw[k++] * vi.dot(xi - model.walls.x[w]); });
-    const PorousParticles& porous = state.porous.particles;
+    s.fluid_wall.for_each(i, [&](Index w) { boundary += cw[k++] * vi.dot(xi - model.walls.x[w]); });
+    const std::vector<Vec3>& porous_x = state.porous.particles.x;
     const Real* cp = s.porous_coefficient.data() + i * cap_p;
     k = 0;
     s.fluid_porous.for_each(
-        i, [&](Index w) { sum += cp[k++] * (vi - porous.v[w]).dot(xi - porous.x[w]); });
-    return dt * rho0_2 * sum;
+        i, [&](Index w) { boundary += cp[k++] * (vi - v_porous[w]).dot(xi - porous_x[w]); });
+    return dt * rho0_2 * (fluid + 2 * boundary);
 }
 
 /// One relaxed Jacobi solve for p >= 0 with rho*_i(v*) <= target_i within tolerance rho0, where
-/// v*_i = base_i + dt a^p_i(p); a_out gets a^p(p). Returns the iterations and the last residual.
+/// v*_i = base_i + dt a^p_i(p) and the free fragments take the reaction of p (`fragments`);
+/// a_out gets a^p(p). Returns the iterations and the last residual.
 struct SolveResult {
     int iterations = 0;
     Real max_error = 0;
@@ -82,8 +121,8 @@ struct SolveResult {
 template <class Target>
 SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& p,
                   const std::vector<Vec3>& base, BoundaryPressure boundary,
-                  std::vector<Vec3>& a_out, const Target& target, Real tolerance,
-                  int max_iterations) {
+                  const FragmentResponse& fragments, std::vector<Vec3>& a_out, const Target& target,
+                  Real tolerance, int max_iterations) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Index n = f.size();
@@ -93,18 +132,21 @@ SolveResult relax(const Model& model, State& state, Real dt, std::vector<Real>& 
             a_out[i] = pressure_acceleration(model, state, p, i, boundary);
             s.v_pred[i] = base[i] + dt * a_out[i];
         });
+        if (fragments.active())
+            fragments.member_velocities(model, state, p, boundary, s.porous_v_pred);
         // The complementarity residual: compression where p_i = 0 is allowed to rise, and as much
         // over-pressure as p_i could give back where the fluid expands. A warm start that pushes
         // the fluid apart is thus corrected, not accepted because nothing is compressed.
-        r.max_error = parallel_max(n, 0.0,
-                                   [&](Index i) {
-                                       const Real e = s.rho_err[i] =
-                                           f.rho[i] +
-                                           density_change(model, state, s.v_pred, i, dt) -
-                                           target(i);
-                                       return e > 0 ? e : std::min(-e, s.diagonal[i] * p[i]);
-                                   }) /
-                      model.rho0;
+        r.max_error =
+            parallel_max(n, 0.0,
+                         [&](Index i) {
+                             const Real e = s.rho_err[i] =
+                                 f.rho[i] +
+                                 density_change(model, state, s.v_pred, s.porous_v_pred, i, dt) -
+                                 target(i);
+                             return e > 0 ? e : std::min(-e, s.diagonal[i] * p[i]);
+                         }) /
+            model.rho0;
         ++r.iterations;
         if (r.max_error <= tolerance || r.iterations >= max_iterations) break;
         parallel_for(n, [&](Index i) {
@@ -131,13 +173,15 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     // 1. Divergence, from zero: fluid at or above rho0 may not compress further, lighter fluid up
     //    to rho0. Warm-started from the last step's p_div, a resting column kept moving.
     f.p_divergence.assign(n, 0);
+    s.porous_v_pred = state.porous.particles.v;
+    const FragmentResponse still(model, state, dt, false, nullptr);
     const SolveResult div = relax(
-        model, state, dt, f.p_divergence, f.v, BoundaryPressure::Mirrored, s.a_divergence,
+        model, state, dt, f.p_divergence, f.v, BoundaryPressure::Mirrored, still, s.a_divergence,
         [&](Index i) { return std::max(f.rho[i], rho0); }, fs.max_divergence_error,
         fs.max_iterations);
     report.divergence_iterations = div.iterations;
 
-    // 2. Constant density, with the non-pressure forces.
+    // 2. Constant density, with the non-pressure forces (gravity on the fragments too).
     std::vector<Vec3>& base = s.x_pred;  // reused as the velocity before the density pressure
     base.resize(n);
     parallel_for(n, [&](Index i) { base[i] = f.v[i] + dt * (s.a_divergence[i] + s.a_other[i]); });
@@ -145,12 +189,20 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     // compress without it, zero elsewhere. The full last pressure kept a resting column moving
     // (the solve accepts it unchanged inside its tolerance band); zero cannot hold deep water,
     // whose pressure a Jacobi iteration rebuilds only a layer or two per iteration.
+    const FragmentResponse falling(model, state, dt, true, &f.p_divergence);
+    const std::vector<Real> no_pressure(n, 0);
+    if (falling.active())
+        falling.member_velocities(model, state, no_pressure, BoundaryPressure::Hydrostatic,
+                                  s.porous_v_pred);
+    else
+        s.porous_v_pred = state.porous.particles.v;
     parallel_for(n, [&](Index i) {
-        const bool compressed = f.rho[i] + density_change(model, state, base, i, dt) > rho0;
+        const bool compressed =
+            f.rho[i] + density_change(model, state, base, s.porous_v_pred, i, dt) > rho0;
         f.p[i] = compressed ? 0.5 * f.p[i] : 0;
     });
     const SolveResult density = relax(
-        model, state, dt, f.p, base, BoundaryPressure::Hydrostatic, s.a_pressure,
+        model, state, dt, f.p, base, BoundaryPressure::Hydrostatic, falling, s.a_pressure,
         [&](Index) { return rho0; }, fs.max_density_error, fs.max_iterations);
     report.iterations = density.iterations;
     report.max_density_error = density.max_error;

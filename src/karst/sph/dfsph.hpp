@@ -14,7 +14,11 @@ struct PressureSolveReport {
 /// Stage (docs/method.md §4.3, replaced): divergence-free SPH after Bender & Koschier 2017, with
 /// the Akinci boundary of walls and porous particles. Two solves on the velocities, each a relaxed
 /// Jacobi iteration on the pressures p_i >= 0 of the linearised density
-///   rho*_i = rho_i + dt sum_j m_j (v*_i - v*_j).grad W_ij + dt sum_k Psi_k (v*_i - v_k).grad W_ik:
+///   rho*_i = rho_i + dt sum_j m_j (v*_i - v*_j).grad W_ij + 2 dt sum_k Psi_k (v*_i - v*_k).grad
+///   W_ik
+/// (the boundary twice, as the pressure force has it; dfsph.cpp says why), where the porous
+/// members of free fragments move with the reaction of the pressures (v*_k; interlinked
+/// coupling, coupling/fragment_response.hpp) and gravity:
 /// 1. divergence: v* = v + dt a^p(p_div), until no particle at or above rho0 is compressed
 ///    further (rho*_i <= max(rho_i, rho0) within /fluid/max_divergence_error);
 /// 2. constant density: v* = v + dt (a_div + a_other + a^p(p)), until rho*_i <= rho0 (1 + eta).

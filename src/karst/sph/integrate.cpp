@@ -54,6 +54,8 @@ Real cfl_time_step(const Model& model, const State& state) {
     Real dt = t.dt_max;
     if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
     if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));
+    const Real p_max = parallel_max(f.size(), 0.0, [&](Index i) { return f.p[i]; });
+    if (p_max > 0) dt = std::min(dt, 0.5 * model.dx * std::sqrt(model.rho0 / p_max));
     return std::min(dt, state.dt_solver_limit);
 }
 

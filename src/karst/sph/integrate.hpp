@@ -33,7 +33,11 @@ void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool c
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max), dt_max), or the scene's fixed step
 /// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now;
 /// a_max that of the last step; also at most the pressure solve's bound
-/// (update_solver_time_step_limit).
+/// (update_solver_time_step_limit) and 0.5 dx sqrt(rho0 / p_max).
+/// [D] The last bound: the pressure force's geometric stiffness, about p / (rho0 dx^2) per unit
+/// mass, is integrated explicitly (a particle that moves changes the force the pressure gives
+/// it), and deep water at the M11 step rang up (a 1 m column at dx 0.01 stopped on the watchdog
+/// at t = 1.2 s; with the bound it comes to rest, bench/results/notes.md).
 Real cfl_time_step(const Model& model, const State& state);
 
 }  // namespace karst
