@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -203,6 +204,35 @@ TEST(Cracks, LayeredRockSplitsAlongItsWeakLayers) {
         EXPECT_LT(angle_deg(c.normal, normal), 1e-6);
         EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
     }
+}
+
+// A chain of 40 tets cut after its 5th: the 5-tet piece is under the resolution and is spared,
+// unless it stays anchored (then it is no fragment, and the 35 tets hanging from it break off).
+TEST(MeshSplit, SmallPiecesAreSparedUnlessTheyStayAnchored) {
+    const Index n = 40;
+    std::vector<ElementLink> links;
+    for (Index e = 0; e + 1 < n; ++e) links.push_back({e, e + 1});
+    const std::vector<char> cut_after_five = [&] {
+        std::vector<char> cut(links.size(), 0);
+        cut[4] = 1;
+        return cut;
+    }();
+    std::vector<char> cut = cut_after_five;
+    EXPECT_EQ(spare_small_pieces(n, links, cut, 24), 1);
+    EXPECT_EQ(cut[4], 0);
+    const auto holds_tet_zero = [](std::span<const Index> tets) {
+        return std::find(tets.begin(), tets.end(), Index(0)) != tets.end();
+    };
+    cut = cut_after_five;
+    EXPECT_EQ(spare_small_pieces(n, links, cut, 24, holds_tet_zero), 0);
+    EXPECT_EQ(cut[4], 1);
+    // An anchor in the big piece does not excuse the small free one.
+    const auto holds_last_tet = [&](std::span<const Index> tets) {
+        return std::find(tets.begin(), tets.end(), n - 1) != tets.end();
+    };
+    cut = cut_after_five;
+    EXPECT_EQ(spare_small_pieces(n, links, cut, 24, holds_last_tet), 1);
+    EXPECT_EQ(cut[4], 0);
 }
 
 TEST(MeshSplit, ACutThroughABarSplitsItsNodesAndSharesTheirVolume) {
