@@ -3,11 +3,12 @@
 // end (goal: every particle under 0.02 m/s), the plane-averaged pressure against rho0 g depth
 // below the top two layers (goal: within 3 %, L2), the energy's largest rise over its start and
 // over its lowest value so far (a closed system may lose energy, never gain it), particles lost
-// and pushed back from walls, steps and seconds. A run the watchdog stops is reported with its
-// message.
+// and pushed back from walls, steps and seconds, and the density solve's mean iterations and
+// the share of steps that ended at its cap (a solve stopped unconverged). A run the watchdog stops
+// is reported with its message.
 //
 //   karst_bench_rest [--scene NAME|all] [--solver dfsph|pcisph|both] [--end T]
-//                    [--dt-max S] [--tolerance ETA] [--threads N]
+//                    [--dt-max S] [--tolerance ETA] [--max-iterations N] [--threads N]
 //
 // column: 0.08 x 0.08 x 1 m of water at dx 0.01 (100 layers) in a closed box. l_tank: water
 // 0.3 m deep in an L-shaped tank at dx 0.01 (a 0.3 x 0.1 x 0.4 m container with a 0.15 m step
@@ -74,8 +75,9 @@ const std::map<std::string, nlohmann::json> k_scenes = {
 
 struct Settings {
     Real end = 2;
-    Real dt_max = 0;     ///< 0: the scene default
-    Real tolerance = 0;  ///< 0: the scene default
+    Real dt_max = 0;         ///< 0: the scene default
+    Real tolerance = 0;      ///< 0: the scene default
+    int max_iterations = 0;  ///< 0: the scene default
 };
 
 /// Heights along -g of the fluid particles, m.
@@ -130,6 +132,7 @@ void run(const std::string& name, const std::string& solver, const Settings& set
     json["fluid"]["solver"] = solver;
     if (settings.dt_max > 0) json["time"]["dt_max"] = settings.dt_max;
     if (settings.tolerance > 0) json["fluid"]["max_density_error"] = settings.tolerance;
+    if (settings.max_iterations > 0) json["fluid"]["max_iterations"] = settings.max_iterations;
     const Model model = build_model(parse_scene(json.dump()));
     State state = make_initial_state(model);
     const Index top_layer = top_layer_size(model, state.fluid);
@@ -137,10 +140,14 @@ void run(const std::string& name, const std::string& solver, const Settings& set
     StepProfile profile;
     std::string failure;
     Stopwatch watch;
+    Index iterations = 0, capped = 0, steps = 0;
     try {
         while (state.time < settings.end) {
-            step(model, state, next_step_length(model, state, settings.end), profile);
+            const StepReport report =
+                step(model, state, next_step_length(model, state, settings.end), profile);
             energy.add(mechanical_energy(model, state));
+            iterations += report.pressure_iterations, ++steps;
+            capped += report.pressure_iterations >= model.scene.fluid.max_iterations;
         }
     } catch (const std::runtime_error& e) {
         failure = e.what();
@@ -149,11 +156,12 @@ void run(const std::string& name, const std::string& solver, const Settings& set
     fmt::print(
         "{:7} {:6}  t {:.3f} s  {:5} steps  speed p99 {:.4f} max {:.4f} m/s  pressure L2 {:.1f} %"
         "  energy rise over start {:.4f} J, over its lowest {:.4f} J  lost {}  pushed back {}"
-        "  {:.1f} s{}\n",
+        "  density solve {:.1f} iterations, {:.0f} % at the cap  {:.1f} s{}\n",
         name, solver, state.time, state.steps, p99, fastest,
         100 * hydrostatic_l2(model, state.fluid, top_layer), energy.largest_rise_over_start(),
-        energy.largest_gain(), state.removed, state.pushed_back, watch.seconds(),
-        failure.empty() ? "" : "\n        stopped: " + failure);
+        energy.largest_gain(), state.removed, state.pushed_back,
+        steps > 0 ? Real(iterations) / steps : 0, steps > 0 ? 100.0 * capped / steps : 0,
+        watch.seconds(), failure.empty() ? "" : "\n        stopped: " + failure);
 }
 
 }  // namespace
@@ -183,6 +191,8 @@ int main(int argc, char** argv) {
                 settings.dt_max = number();
             else if (key == "--tolerance")
                 settings.tolerance = number();
+            else if (key == "--max-iterations")
+                settings.max_iterations = int(number());
             else if (key == "--threads")
                 threads = int(number());
             else

@@ -190,10 +190,9 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     // (the solve accepts it unchanged inside its tolerance band); zero cannot hold deep water,
     // whose pressure a Jacobi iteration rebuilds only a layer or two per iteration.
     const FragmentResponse falling(model, state, dt, true, &f.p_divergence);
-    const std::vector<Real> no_pressure(n, 0);
     if (falling.active())
-        falling.member_velocities(model, state, no_pressure, BoundaryPressure::Hydrostatic,
-                                  s.porous_v_pred);
+        falling.member_velocities(model, state, std::vector<Real>(n, 0),
+                                  BoundaryPressure::Hydrostatic, s.porous_v_pred);
     else
         s.porous_v_pred = state.porous.particles.v;
     parallel_for(n, [&](Index i) {
