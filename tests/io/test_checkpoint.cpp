@@ -44,7 +44,7 @@ const char* k_cracking = R"({
   "porous_solids": [ {
     "shape": { "type": "box", "min": [0, 0, 0], "max": [0.3, 0.3, 0.25] },
     "material": { "porosity": 0.3, "permeability": 1e-11, "darcy_viscosity": 0.1, "youngs_modulus": 1e6,
-                  "initial_saturation": 1.0, "tensile_strength": 1.5e4, "fracture_energy": 1.0 },
+                  "initial_saturation": 1.0, "tensile_strength": 1.6e4, "fracture_energy": 1.0 },
     "wet_regions": [ { "region": { "type": "sphere", "center": [0.15, 0.15, 0.125], "radius": 0.06 }, "saturation": 1.2 } ],
     "constraints": [ { "kind": "fixed", "region": { "type": "box", "min": [-1, -1, -1], "max": [1, 1, 0] } } ] } ],
   "output": { "fps": 10 }

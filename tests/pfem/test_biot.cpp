@@ -2,6 +2,9 @@
 // consolidation against the series solution, and fixed-stress against fixed-strain splitting.
 #include "karst/pfem/biot.hpp"
 #include "karst/pfem/box_nodes.hpp"
+#include "karst/pfem/cracks.hpp"
+#include "karst/pfem/face_links.hpp"
+#include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/nodal_stress.hpp"
 
 #include <gtest/gtest.h>
@@ -228,6 +231,49 @@ TEST(Biot, SteadyLoadsReuseTheLastMechanicsSolveAsThePredictor) {
     EXPECT_GT(p_ref, 0);
     EXPECT_LT(p_err, 1e-10 * p_ref);
     EXPECT_LT(u_err, 1e-10 * u_ref);
+}
+
+TEST(Biot, ACrackedColumnSolvedThroughItsUncrackedFactorMatchesAFreshFactorisation) {
+    // A crack disk inside Terzaghi's column splits its nodes (M27, each copy where its source
+    // was, as in the structures): the solver made from the uncracked one's factor ends its call
+    // where a freshly factorised solver of the cracked mesh does.
+    const Real width = 1;
+    const TetMesh mesh = box_mesh(Vec3::Zero(), Vec3(width, width, Terzaghi::h), 0.25);
+    BiotSolver whole(mesh, terzaghi_problem(mesh, width));
+    const std::vector<ElementLink> links = face_links(mesh);
+    Crack c;
+    c.centre = Vec3(0.5, 0.5, 5), c.normal = Vec3::UnitZ(), c.radius = 0.4;
+    const std::vector<Index> cutter = links_cut(mesh, links, std::span(&c, 1));
+    std::vector<char> broken(links.size());
+    for (size_t k = 0; k < links.size(); ++k) broken[k] = cutter[k] >= 0;
+    const MeshSplit split = split_mesh(mesh, links, broken, 0);
+    ASSERT_EQ(split.components, 1);
+    ASSERT_GT(split.split_nodes, 0);
+    BiotOptions options;
+    options.split_memory_share = 1;
+    const BiotProblem problem = terzaghi_problem(split.mesh, width);
+    const BiotSplitOf split_of{whole, split.source};
+    BiotSolver through_old(split.mesh, problem, options, &split_of), fresh(split.mesh, problem);
+    EXPECT_EQ(through_old.elastic_split_unknowns(), 3 * split.split_nodes);
+    EXPECT_EQ(fresh.elastic_split_unknowns(), 0);
+    BiotFields a{std::vector<Vec3>(split.mesh.node_count(), Vec3::Zero()),
+                 std::vector<Real>(split.mesh.node_count(), 0)},
+        b = a;
+    through_old.advance(0.005, a), fresh.advance(0.005, b);
+    Real u_err = 0, u_ref = 0, p_err = 0, p_ref = 0;
+    for (Index n = 0; n < split.mesh.node_count(); ++n) {
+        u_err = std::max(u_err, (a.u[n] - b.u[n]).norm()), u_ref = std::max(u_ref, b.u[n].norm());
+        p_err = std::max(p_err, std::abs(a.p[n] - b.p[n])),
+        p_ref = std::max(p_ref, std::abs(b.p[n]));
+    }
+    EXPECT_GT(u_ref, 0);
+    EXPECT_LT(u_err, 1e-10 * u_ref);
+    EXPECT_LT(p_err, 1e-10 * p_ref);
+    // The crack opens: a copy and its source move apart.
+    Real opening = 0;
+    for (Index n = mesh.node_count(); n < split.mesh.node_count(); ++n)
+        opening = std::max(opening, (b.u[n] - b.u[split.source[n]]).norm());
+    EXPECT_GT(opening, 1e-6 * u_ref);
 }
 
 TEST(Biot, AmgSolversMatchTheDirectSolverOnTerzaghi) {

@@ -16,7 +16,7 @@
 
 namespace karst {
 
-BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
+BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o, const BiotSplitOf* split_of)
     : mesh(m), problem(std::move(p)), options(o), n(m.node_count()) {
     KARST_CHECK(problem.mobility.size() == size_t(mesh.tet_count()));
     Stopwatch watch;
@@ -52,11 +52,33 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o)
     flow_iterative = options.linear_solver == LinearSolver::Amg ||
                      (options.linear_solver == LinearSolver::Auto &&
                       p_dofs.free_count >= options.amg_flow_unknowns);
-    if (u_dofs.free_count > 0)
+    const bool split = split_of && !options.polyhedral && !elastic_iterative && tie.cols() == 0 &&
+                       u_dofs.free_count > 0 && split_elastic(*split_of);
+    if (u_dofs.free_count > 0 && !split)
         elastic.compute(tie.cols() > 0 ? SparseMatrix(tie.transpose() * K_ff * tie) : K_ff,
                         elastic_iterative,
                         elastic_iterative ? elastic_amg_options() : AmgOptions{});
     t_elastic_factor = factor_watch.seconds();
+}
+
+bool BiotSolver::Impl::split_elastic(const BiotSplitOf& split_of) {
+    const Impl& parent = *split_of.solver.m_impl;
+    if (parent.elastic_iterative || parent.tie.cols() > 0 ||
+        split_of.node_source.size() != size_t(n))
+        return false;
+    std::vector<Index> parent_row(size_t(u_dofs.free_count), -1);
+    for (Index a = 0; a < n; ++a) {
+        const Index source = split_of.node_source[a];
+        if (source < 0 || source >= parent.n) return false;
+        for (Index c = 0; c < 3; ++c) {
+            const int row = u_dofs.free_index[3 * a + c];
+            if (row < 0) continue;
+            const int from = parent.u_dofs.free_index[3 * source + c];
+            if (from < 0) return false;
+            parent_row[row] = from;
+        }
+    }
+    return elastic.compute_split(K_ff, parent.elastic, parent_row, options.split_memory_share);
 }
 
 void BiotSolver::Impl::tie_platens() {
@@ -194,8 +216,9 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
     return report;
 }
 
-BiotSolver::BiotSolver(const TetMesh& mesh, BiotProblem problem, BiotOptions options)
-    : m_impl(std::make_unique<Impl>(mesh, std::move(problem), options)) {}
+BiotSolver::BiotSolver(const TetMesh& mesh, BiotProblem problem, BiotOptions options,
+                       const BiotSplitOf* split_of)
+    : m_impl(std::make_unique<Impl>(mesh, std::move(problem), options, split_of)) {}
 BiotSolver::~BiotSolver() = default;
 BiotSolver::BiotSolver(BiotSolver&&) noexcept = default;
 BiotSolver& BiotSolver::operator=(BiotSolver&&) noexcept = default;
@@ -285,6 +308,9 @@ Index BiotSolver::displacement_unknowns() const {
 }
 bool BiotSolver::elastic_by_amg() const {
     return m_impl->elastic_iterative;
+}
+Index BiotSolver::elastic_split_unknowns() const {
+    return m_impl->elastic.split_unknowns();
 }
 bool BiotSolver::flow_by_amg() const {
     return m_impl->flow_iterative;

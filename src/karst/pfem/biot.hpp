@@ -91,6 +91,10 @@ struct BiotOptions {
     /// Auto: the flow goes to AMG from this many free pressure unknowns (the crossover of a call
     /// that refactorises the flow, bench_pfem --edge).
     Index amg_flow_unknowns = 30000;
+    /// [D] A split mesh's elasticity is solved through the older factor (BiotSplitOf) while the
+    /// crack jumps' dense block takes at most this share of that factor's entries: past it a
+    /// new factorisation is smaller, and its solves are cheaper.
+    Real split_memory_share = 0.25;
 };
 
 struct BiotFields {
@@ -110,9 +114,21 @@ struct BiotCallReport {
 /// Owns the assembled, Dirichlet-reduced matrices and their factorisations (CHOLMOD). The
 /// elasticity matrix is factorised once per mesh (in the constructor); the flow matrix once per
 /// call, since dt and the mobility may change.
+class BiotSolver;
+
+/// The solver of a mesh that fracture made from another's by splitting nodes (M27), and per
+/// node of the new mesh the node of the old one that it is or copies.
+struct BiotSplitOf {
+    const BiotSolver& solver;
+    const std::vector<Index>& node_source;
+};
+
 class BiotSolver {
 public:
-    BiotSolver(const TetMesh& mesh, BiotProblem problem, BiotOptions options = {});
+    /// With `split_of`, the elasticity of a split mesh is solved through the old solver's factor
+    /// (SpdSolve::compute_split) where it can be, instead of a new factorisation.
+    BiotSolver(const TetMesh& mesh, BiotProblem problem, BiotOptions options = {},
+               const BiotSplitOf* split_of = nullptr);
     ~BiotSolver();
     BiotSolver(BiotSolver&&) noexcept;
     BiotSolver& operator=(BiotSolver&&) noexcept;
@@ -152,6 +168,8 @@ public:
     Index displacement_unknowns() const;
     /// The solver each system got (LinearSolver): true where BoomerAMG-CG, false where CHOLMOD.
     bool elastic_by_amg() const;
+    /// The crack jumps through which the elasticity is solved on an older factor (0: its own).
+    Index elastic_split_unknowns() const;
     bool flow_by_amg() const;
 
 private:

@@ -44,7 +44,9 @@ struct BiotSolver::Impl {
 
     LoadBalance balance;  // the unheld pieces' loads against their rigid modes
 
-    Impl(const TetMesh& m, BiotProblem p, BiotOptions o);
+    Impl(const TetMesh& m, BiotProblem p, BiotOptions o, const BiotSplitOf* split_of);
+    /// K_ff set up through the factor of the solver it splits; false where it cannot be.
+    bool split_elastic(const BiotSplitOf& split_of);
     /// Systems AMG over the free displacement rows: each row keeps its component.
     AmgOptions elastic_amg_options() const;
     /// P1 mechanics straight into compressed columns, in parallel over nodes (each node owns its

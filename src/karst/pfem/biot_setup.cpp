@@ -244,8 +244,8 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
 }
 
 BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem,
-                            PfemTimings& timings) {
-    BiotSolver solver(mesh, std::move(problem), biot_options(model));
+                            PfemTimings& timings, const BiotSplitOf* split_of) {
+    BiotSolver solver(mesh, std::move(problem), biot_options(model), split_of);
     timings.assembly += solver.seconds_assembly();
     timings.factorisation += solver.seconds_elastic_factorisation();
     return solver;

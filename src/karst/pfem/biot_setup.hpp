@@ -63,10 +63,10 @@ std::vector<std::vector<Index>> unheld_pieces(const TetMesh& mesh,
 BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                          const std::vector<Mat3>& node_tensors);
 
-/// Builds the solver with the scene's /poroelastic settings and adds its assembly and
-/// factorisation times.
+/// Builds the solver with the scene's /poroelastic settings (through the factor of the solver
+/// it splits, where given: BiotSolver) and adds its assembly and factorisation times.
 BiotSolver make_biot_solver(const Model& model, const TetMesh& mesh, BiotProblem problem,
-                            PfemTimings& timings);
+                            PfemTimings& timings, const BiotSplitOf* split_of = nullptr);
 
 /// Porosity (M23) and permeability scale k/k0 (M24) at every node, from the nodal strain and
 /// the Biot pressure.

@@ -208,11 +208,19 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     Structure next;
     next.fragment = s.fragment, next.solid = s.solid;
     next.mesh_version = st.next_mesh_version++;
+    next.split_of_version = s.mesh_version;
     const Index n = mesh.node_count();
+    next.split_source.resize(n);
     next.node_id.resize(n), next.fields.u.resize(n), next.fields.p.resize(n), next.u_from.resize(n);
     next.node_tensors.resize(n), next.permeability_scale.resize(n);
     for (Index a = 0; a < n; ++a) {
         const Index k = node_of[a], from = split.source[k];
+        // [D] The mesh keeps each copy where its source was (the particles and rest_x take the
+        // offset, for a later Delaunay): the elements keep their shapes, so a split leaves the
+        // strain, stress and elastic energy of the carried u as they were, and the elasticity
+        // is the old one with nodes duplicated, which the old factor solves (BiotSplitOf).
+        next.split_source[a] = from;
+        mesh.nodes[a] = s.mesh.nodes[from];
         next.node_id[a] = node_id[k];
         next.fields.u[a] = s.fields.u[from], next.fields.p[a] = s.fields.p[from];
         next.u_from[a] = s.u_from[from], next.node_tensors[a] = s.node_tensors[from];

@@ -99,14 +99,31 @@ public:
     /// Factorises or sets up A. CHOLMOD's pattern analysis is done once: every A given to one
     /// SpdSolve has the same pattern (the mesh's).
     void compute(const SparseMatrix& A, bool iterative, const AmgOptions& amg_options);
+    /// Sets up A (stored in full) as a split of the direct `parent`'s matrix A_p without a new
+    /// factorisation: A's row r is parent row `parent_row[r]` or a copy of it (nodes duplicated
+    /// along a crack, each copy where its source was), so that Z^T A Z = A_p for the Z that
+    /// copies each parent row's value into its copies. In the unknowns W = [Z, E] (E: the
+    /// copies' jumps) A is [[A_p, B], [B^T, C]], and A_p's factor (shared: the root of a chain
+    /// of splits) with the dense Schur complement C - B^T A_p^{-1} B on the jumps solves it
+    /// exactly, at one solve with A_p's factor. That solve preconditions CG on A, which ends at
+    /// once where Z^T A Z = A_p holds and factorises A afresh where CG does not converge.
+    /// Returns false, leaving this solve unset, when A is no split (a parent row without a row)
+    /// or the jumps' dense block A_p^{-1} B would hold over `max_memory_share` of the factor's
+    /// entries: then compute() is the way.
+    bool compute_split(const SparseMatrix& A, const SpdSolve& parent,
+                       const std::vector<Index>& parent_row, Real max_memory_share);
+    /// The jumps of a split (0 after compute()).
+    Index split_unknowns() const;
     /// x = A^{-1} b; `guess` starts the iteration.
     Vector solve(const Vector& b, const Vector& guess);
     Index iterations = 0;  ///< CG iterations so far (iterative mode)
 
 private:
     struct Direct;
+    struct Split;
     bool m_iterative = false;
-    std::unique_ptr<Direct> m_direct;
+    std::shared_ptr<Direct> m_direct;  // shared with the splits of this matrix
+    std::unique_ptr<Split> m_split;
     std::unique_ptr<AmgSolver> m_amg;
 };
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 namespace karst {
 
@@ -33,7 +34,6 @@ std::vector<Index> index_by_id(const PorousParticles& p, size_t ids) {
 BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     Structure& s = state.structures.structures[slot];
     if (BiotCache::Entry* e = state.biot_cache.find(slot, s.mesh_version)) return *e->solver;
-    BiotCache::Entry& e = state.biot_cache.reset(slot);
     const PorousSolid& solid = model.scene.porous_solids[s.solid];
     BiotProblem problem = biot_problem(model, solid, s.mesh, s.node_tensors);
     // [D] Geostatic start in a coupled run: a fragment's rest state is its state at rest under
@@ -44,7 +44,15 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     // arrived. Biot is linear, so dropping a constant load only shifts the reference state. A
     // poroelastic-only solid keeps gravity: consolidation under its weight is what it shows.
     if (!model.poroelastic_only()) problem.gravity = Vec3::Zero();
-    e.solver.emplace(make_biot_solver(model, s.mesh, std::move(problem), state.structures.timings));
+    std::optional<BiotSplitOf> split_of;
+    if (BiotCache::Entry* older =
+            s.split_of_version >= 0 ? state.biot_cache.find(slot, s.split_of_version) : nullptr)
+        split_of.emplace(BiotSplitOf{*older->solver, s.split_source});
+    BiotSolver solver = make_biot_solver(model, s.mesh, std::move(problem),
+                                         state.structures.timings, split_of ? &*split_of : nullptr);
+    s.split_of_version = -1, s.split_source.clear();
+    BiotCache::Entry& e = state.biot_cache.reset(slot);
+    e.solver.emplace(std::move(solver));
     e.mesh_version = s.mesh_version;
     // The flow matrix the run was using: a new mesh starts from the problem's (scale 1); a solver
     // rebuilt for a mesh it had already (a resumed run) takes the scales it was assembled with.
@@ -81,6 +89,7 @@ void build(const Model& model, State& state, size_t slot) {
     s.mesh = mesh_points(model, x, st.timings);
     s.mesh_version = st.next_mesh_version++;
     s.mobility_scale.clear(), s.flow_time_step = -1;  // a new mesh's solver starts afresh
+    s.split_of_version = -1, s.split_source.clear();
     s.links = face_links(s.mesh);
     const Index n = s.mesh.node_count();
     s.node_tensors.resize(n), s.fields.u.resize(n), s.fields.p.assign(n, 0),
@@ -279,6 +288,14 @@ void end_biot_call(State& state) {
     StructureState& st = state.structures;
     std::fill(st.impulse.begin(), st.impulse.end(), Vec3::Zero());
     st.elapsed = 0;
+}
+
+void release_split_solvers(State& state) {
+    for (size_t slot = 0; slot < state.structures.structures.size(); ++slot) {
+        const BiotCache::Entry* e =
+            state.biot_cache.find(slot, state.structures.structures[slot].mesh_version);
+        if (e && e->solver->elastic_split_unknowns() > 0) state.biot_cache.reset(slot);
+    }
 }
 
 bool feed_back_structures(const Model& model, State& state) {

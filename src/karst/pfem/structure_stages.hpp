@@ -59,6 +59,11 @@ void end_biot_call(State& state);
 /// by over 1 % since the pore-flow pairs were built on them (the pairs are then stale).
 bool feed_back_structures(const Model& model, State& state);
 
+/// Drops the solvers that solve a cracked mesh through an older factor (BiotSplitOf), once the
+/// call that cracked it is over: they serve its repeated solves, and the next call factorises
+/// the mesh afresh, as a run resumed from a checkpoint in between does (resumes are exact).
+void release_split_solvers(State& state);
+
 /// Appends every structure's mesh and fields (nodes at their rest positions X) to `frame`.
 void append_structure_meshes(const Model& model, State& state, MeshFrame& frame);
 

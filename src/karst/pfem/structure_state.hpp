@@ -42,6 +42,11 @@ struct Structure {
     std::vector<char> well_shaped;  ///< per tet: dihedral angles of at least 2 degrees at rest
     bool distorted = false;  ///< the last call left a distorted element: remesh before the next
     bool grown = false;      ///< a merged fragment's particles joined: remesh before the next call
+    /// Set by fracture (not saved: a resumed run factorises afresh): the mesh this one split,
+    /// and per node the node of that mesh it is or copies, so that its solver can reuse the
+    /// older factor (BiotSplitOf).
+    std::int64_t split_of_version = -1;
+    std::vector<Index> split_source;
 };
 
 /// Seconds spent per PFEM phase and what the calls did, summed over structures and calls

@@ -261,6 +261,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             timed(profile, Stage::Structure, [&] {
                 end_biot_call(state);
                 if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
+                release_split_solvers(state);
             });
         }
         check_vectors(state.porous.particles.x, state.porous.particles.id, Stage::Structure, t + dt,
