@@ -111,9 +111,6 @@ struct BiotCallReport {
     int elastic_solves = 0;       ///< predictor (when needed) and one per iteration
 };
 
-/// Owns the assembled, Dirichlet-reduced matrices and their factorisations (CHOLMOD). The
-/// elasticity matrix is factorised once per mesh (in the constructor); the flow matrix once per
-/// call, since dt and the mobility may change.
 class BiotSolver;
 
 /// The solver of a mesh that fracture made from another's by splitting nodes (M27), and per
@@ -123,6 +120,9 @@ struct BiotSplitOf {
     const std::vector<Index>& node_source;
 };
 
+/// Owns the assembled, Dirichlet-reduced matrices and their factorisations (CHOLMOD). The
+/// elasticity matrix is factorised once per mesh (in the constructor); the flow matrix once per
+/// call, since dt and the mobility may change.
 class BiotSolver {
 public:
     /// With `split_of`, the elasticity of a split mesh is solved through the old solver's factor

@@ -150,11 +150,15 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         st.impulse[node_id[k]] = st.impulse[parent];
     }
     const std::vector<Index> particle = index_by_id(p, st.node_of.size());
+    // The mesh holds a node where it was before any split (below), rest_x where its particle
+    // rests: a node split again keeps its earlier offsets.
+    std::vector<Vec3> rest_before(n_old);
+    for (Index a = 0; a < n_old; ++a) rest_before[a] = st.rest_x[s.node_id[a]];
     for (Index k = 0; k < n_new; ++k) {
         const Index id = node_id[k], a = split.source[k], i = particle[id];
         const Vec3 move = split.mesh.nodes[k] - s.mesh.nodes[a];
         const Real share = split.share[k];
-        st.rest_x[id] = split.mesh.nodes[k], st.u[id] = s.fields.u[a];
+        st.rest_x[id] = rest_before[a] + move, st.u[id] = s.fields.u[a];
         st.rest_volume[id] *= share, st.paired_volume[id] *= share, st.impulse[id] *= share;
         if (i < 0) continue;
         p.x[i] += move;
