@@ -11,13 +11,11 @@ namespace karst {
 namespace {
 
 // A grid of side x side nodes joined by springs, with a weak spring to the ground at every node:
-// the scalar analogue of a P1 elasticity. `owner` maps each node to its row (a copy's row where
-// a cut duplicated it), `edge_owner` the two rows each spring acts on.
+// the scalar analogue of a P1 elasticity. Rows past side^2 are copies that cuts made.
 struct SpringGrid {
     Index side = 0;
-    std::vector<std::pair<Index, Index>> edges;
-    std::vector<Real> stiffness;
-    std::vector<std::pair<Index, Index>> edge_rows;  // per edge: the rows of its two ends
+    std::vector<Real> stiffness;                     // per spring
+    std::vector<std::pair<Index, Index>> edge_rows;  // per spring: the rows of its two ends
     std::vector<Index> source;                       // per row: the node it is or copies
     std::vector<Real> ground_share;                  // per row: its share of the ground spring
 
@@ -26,14 +24,20 @@ struct SpringGrid {
         std::uniform_real_distribution<Real> k(0.5, 2.0);
         for (Index i = 0; i < n; ++i)
             for (Index j = 0; j < n; ++j) {
-                if (i + 1 < n) edges.push_back({i * n + j, (i + 1) * n + j});
-                if (j + 1 < n) edges.push_back({i * n + j, i * n + j + 1});
+                if (i + 1 < n) edge_rows.push_back({i * n + j, (i + 1) * n + j});
+                if (j + 1 < n) edge_rows.push_back({i * n + j, i * n + j + 1});
             }
-        for (size_t e = 0; e < edges.size(); ++e) stiffness.push_back(k(random));
-        edge_rows = edges;
+        for (size_t e = 0; e < edge_rows.size(); ++e) stiffness.push_back(k(random));
         for (Index a = 0; a < n * n; ++a) source.push_back(a), ground_share.push_back(1);
     }
     Index column(Index row) const { return source[row] % side; }
+    /// Scales every spring between two uncut rows (no copy at either end) by scale().
+    template <class Scale>
+    void scale_springs_off_copies(Scale scale) {
+        for (size_t e = 0; e < edge_rows.size(); ++e)
+            if (edge_rows[e].first < side * side && edge_rows[e].second < side * side)
+                stiffness[e] *= scale();
+    }
     /// Cuts between grid columns c and c + 1 over rows [i0, i1): the nodes of column c get a copy
     /// that takes their springs to the right.
     void cut(Index c, Index i0, Index i1) {
@@ -53,7 +57,7 @@ struct SpringGrid {
     }
     SparseMatrix matrix() const {
         Triplets t;
-        for (size_t e = 0; e < edges.size(); ++e) {
+        for (size_t e = 0; e < edge_rows.size(); ++e) {
             const auto [a, b] = edge_rows[e];
             const Real k = stiffness[e];
             t.emplace_back(int(a), int(a), k), t.emplace_back(int(b), int(b), k);
@@ -66,6 +70,12 @@ struct SpringGrid {
         return A;
     }
 };
+
+SpdSolve factorised(const SpringGrid& grid) {
+    SpdSolve solve;
+    solve.compute(grid.matrix(), false, {});
+    return solve;
+}
 
 Vector load(Index rows) {
     Vector b(rows);
@@ -92,8 +102,7 @@ std::vector<Index> rows_in(const SpringGrid& now, const SpringGrid& before) {
 
 TEST(SpdSplit, ACutMatrixSolvedThroughTheUncutFactorMatchesItsOwnFactorisation) {
     SpringGrid grid(30);
-    SpdSolve whole;
-    whole.compute(grid.matrix(), false, {});
+    const SpdSolve whole = factorised(grid);
     SpringGrid once = grid;
     once.cut(14, 5, 25);  // 20 nodes split: a crack inside the plate
     SpdSolve split;
@@ -113,16 +122,13 @@ TEST(SpdSplit, ACutMatrixSolvedThroughTheUncutFactorMatchesItsOwnFactorisation) 
 
 TEST(SpdSplit, ANearSplitIsSolvedByCgAndAFarOneByAFreshFactorisation) {
     SpringGrid grid(20);
-    SpdSolve whole;
-    whole.compute(grid.matrix(), false, {});
+    const SpdSolve whole = factorised(grid);
     SpringGrid cut = grid;
     cut.cut(9, 4, 16);  // a crack inside the plate
     // Springs away from the copies 10 % stiffer: Z^T A Z is no longer the factorised matrix,
     // and the split solve preconditions CG.
     SpringGrid moved = cut;
-    for (size_t e = 0; e < moved.edges.size(); ++e)
-        if (moved.edge_rows[e].first < 400 && moved.edge_rows[e].second < 400)
-            moved.stiffness[e] *= 1.1;
+    moved.scale_springs_off_copies([] { return 1.1; });
     SpdSolve near;
     ASSERT_TRUE(near.compute_split(moved.matrix(), whole, rows_in(moved, grid), 100.0));
     EXPECT_LT(solve_difference(near, moved.matrix()), 1e-9);
@@ -133,9 +139,7 @@ TEST(SpdSplit, ANearSplitIsSolvedByCgAndAFarOneByAFreshFactorisation) {
     SpringGrid far = cut;
     std::mt19937 random(3);
     std::uniform_real_distribution<Real> power(-2, 2);
-    for (size_t e = 0; e < far.edges.size(); ++e)
-        if (far.edge_rows[e].first < 400 && far.edge_rows[e].second < 400)
-            far.stiffness[e] *= std::pow(10.0, power(random));
+    far.scale_springs_off_copies([&] { return std::pow(10.0, power(random)); });
     SpdSolve refactorised;
     ASSERT_TRUE(refactorised.compute_split(far.matrix(), whole, rows_in(far, grid), 100.0));
     EXPECT_LT(solve_difference(refactorised, far.matrix()), 1e-10);
@@ -144,8 +148,7 @@ TEST(SpdSplit, ANearSplitIsSolvedByCgAndAFarOneByAFreshFactorisation) {
 
 TEST(SpdSplit, AMatrixThatIsNoSplitOrTooBigASplitIsRefused) {
     SpringGrid grid(20);
-    SpdSolve whole;
-    whole.compute(grid.matrix(), false, {});
+    const SpdSolve whole = factorised(grid);
     SpringGrid cut = grid;
     cut.cut(9, 0, 20);  // cuts the plate in two
     SpdSolve split;
