@@ -200,6 +200,61 @@ TEST(FractureScene, AnOverhangHeavierThanItsStrengthBreaksOffAndFalls) {
     EXPECT_EQ(strong.state.porous.fragments.size(), 1u);
 }
 
+/// The overhang in a coupled run: a tank around it with a puddle of water on its floor, far
+/// below. The Biot problem then starts from the rest state under the rock's weight
+/// (structure_stages.cpp), and the weight acts through that state's stress.
+std::string coupled_overhang(Real tensile_strength) {
+    return fmt::format(R"({{
+      "name": "coupled_overhang", "particle_spacing": 0.05, "poroelastic": {{ "time_step": 0.02 }},
+      "fluid_blocks": [ {{ "shape": {{ "type": "box", "min": [1.0, 0.3, -1.0], "max": [1.4, 0.6, -0.9] }} }} ],
+      "walls": [ {{ "kind": "container", "shape": {{ "type": "box", "min": [-0.5, -0.5, -1], "max": [1.5, 0.7, 0.7] }} }} ],
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [1.0, 0.2, 0.2] }},
+        "material": {{ "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e7, "tensile_strength": {} }},
+        "constraints": [ {{ "kind": "fixed", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] }} }} ] }} ]
+    }})",
+                       tensile_strength);
+}
+
+TEST(FractureScene, InACoupledRunAnOverhangStandsInItsRestStateAndBreaksOffWhenTooWeak) {
+    // Strong: the rock stands where it was built (u is measured from its rest state under its
+    // weight), while that state sags as a cantilever does, and it never cracks.
+    test::Simulation strong(coupled_overhang(3e6));
+    ASSERT_FALSE(strong.model.poroelastic_only());
+    strong.run_until(0.3);
+    EXPECT_EQ(strong.state.structures.fracture.cracks, 0);
+    const StructureState& st = strong.state.structures;
+    const Structure& s = st.structures.at(0);
+    // The mesh spans the particles' centres: a beam of L = 0.95 m and a 0.15 m square section.
+    Vec3 lo = s.mesh.nodes[0], hi = lo;
+    for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+    Real largest_u = 0, tip_sag = 0;
+    for (Index a = 0; a < s.mesh.node_count(); ++a) {
+        largest_u = std::max(largest_u, s.fields.u[a].norm());
+        if (s.mesh.nodes[a][0] > hi[0] - 1e-9)
+            tip_sag = std::min(tip_sag, st.weight_u[s.node_id[a]][2]);
+    }
+    const PorousParticles& p = strong.state.porous.particles;
+    const Real mass = std::accumulate(p.solid_mass.begin(), p.solid_mass.end(), Real(0));
+    const Real L = hi[0] - lo[0], h = hi[2] - lo[2], q = mass * 9.81 / L;        // m, m, N/m
+    const Real beam_sag = q * std::pow(L, 4) / (8 * 1e7 * std::pow(h, 4) / 12);  // q L^4 / 8 E I
+    EXPECT_LT(largest_u, 1e-6 * beam_sag) << "m: the rest state holds the weight";
+    // Linear tets three across bend stiffer than a beam (measured: 0.77 of it).
+    EXPECT_GT(-tip_sag, 0.6 * beam_sag) << "m";
+    EXPECT_LT(-tip_sag, 1.05 * beam_sag) << "m";
+
+    // Weak: the root stress of the weight (3.2e5 Pa) cracks it, and the overhang falls.
+    test::Simulation weak(coupled_overhang(1e5));
+    weak.run_until(0.3);
+    EXPECT_GT(weak.state.structures.fracture.cracks, 0);
+    const auto& fragments = weak.state.porous.fragments;
+    ASSERT_GE(fragments.size(), 2u);
+    std::vector<Index> members(fragments.size(), 0);
+    for (Index f : weak.state.porous.particles.fragment) ++members[f];
+    const size_t big = std::max_element(members.begin() + 1, members.end()) - members.begin();
+    EXPECT_FALSE(fragments[big].anchored);
+    EXPECT_LT(fragments[big].centre[2], 0.1 - 0.05) << "its centre started at 0.1 m";
+}
+
 /// A free bar 1.2 m x 0.3 m x 0.3 m on a 0.1 m lattice, drained, with the given constraints.
 std::string free_bar(const std::string& constraints) {
     return R"({

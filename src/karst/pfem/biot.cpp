@@ -36,7 +36,7 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o, const Bio
         assemble_p1_mechanics();
     }
     f_body = f_ext;
-    f_extra = Vector::Zero(3 * n);
+    f_extra = Vector::Zero(3 * n), f_rest = Vector::Zero(3 * n);
     apply_boundary_values(problem.nodal_force, problem.prescribed_u, problem.drained_pressure);
     mass_ff = p_dofs.split(mass).first;
     assemble_flow();
@@ -244,7 +244,35 @@ void BiotSolver::set_flow_time_step(Real dt) {
 void BiotSolver::set_extra_loads(const std::vector<Vec3>& loads) {
     KARST_CHECK(loads.size() == size_t(m_impl->n));
     m_impl->f_extra = Eigen::Map<const Vector>(loads[0].data(), 3 * m_impl->n);
-    m_impl->f_ext = m_impl->f_problem + m_impl->f_extra;
+    m_impl->f_ext = m_impl->f_problem + m_impl->f_extra - m_impl->f_rest;
+}
+
+void BiotSolver::set_rest_displacement(const std::vector<Vec3>& u_rest) {
+    Impl& m = *m_impl;
+    KARST_CHECK(u_rest.size() == size_t(m.n));
+    if (m.n == 0) return;
+    const Vector u = Eigen::Map<const Vector>(u_rest[0].data(), 3 * m.n);
+    const Vector u_f = m.u_dofs.gather_free(u), u_c = m.u_dofs.gather_prescribed(u);
+    // K_cf = K_fc^T (K is symmetric).
+    const Vector free = m.K_ff * u_f + m.K_fc * u_c, held = m.K_fc.transpose() * u_f + m.K_cc * u_c;
+    for (Index i = 0, k = 0; i < 3 * m.n; ++i) {
+        const int row = m.u_dofs.free_index[i];
+        m.f_rest[i] = row >= 0 ? free[row] : held[k++];
+    }
+    m.f_ext = m.f_problem + m.f_extra - m.f_rest;
+}
+
+std::vector<Vec3> BiotSolver::drained_displacement(const std::vector<Vec3>& loads) {
+    Impl& m = *m_impl;
+    KARST_CHECK(loads.size() == size_t(m.n));
+    std::vector<Vec3> u_rest(m.n, Vec3::Zero());
+    if (m.n == 0 || m.u_dofs.free_count == 0) return u_rest;
+    Vector rhs = m.u_dofs.gather_free(Eigen::Map<const Vector>(loads[0].data(), 3 * m.n));
+    m.balance.apply(rhs);
+    Vector u = Vector::Zero(3 * m.n);
+    m.u_dofs.scatter_free(m.solve_elastic(rhs, Vector::Zero(m.u_dofs.free_count)), u);
+    Eigen::Map<Vector>(u_rest[0].data(), 3 * m.n) = u;
+    return u_rest;
 }
 
 void BiotSolver::set_boundary_values(const std::vector<Vec3>& nodal_force,
@@ -259,7 +287,7 @@ void BiotSolver::Impl::apply_boundary_values(const std::vector<Vec3>& nodal_forc
     f_problem = f_body;
     for (Index a = 0; a < Index(nodal_force.size()); ++a)
         f_problem.segment<3>(3 * a) += nodal_force[a];
-    f_ext = f_problem + f_extra;
+    f_ext = f_problem + f_extra - f_rest;
     for (Index a = 0; a < n; ++a)
         for (int c = 0; c < 3; ++c)
             if (u_dofs.free_index[3 * a + c] < 0 && !prescribed_u.empty() &&

@@ -150,6 +150,15 @@ public:
     /// the next call on: the fluid's forces on a coupled fragment (docs/method.md §5.3).
     void set_extra_loads(const std::vector<Vec3>& loads);
 
+    /// The rest state the mesh stands in at u = 0 (a coupled fragment under its own weight,
+    /// structure_stages.cpp): its elastic forces K u_rest act against the loads from the next
+    /// call on, so u is measured from it and the stress of u_rest + u is the full one.
+    void set_rest_displacement(const std::vector<Vec3>& u_rest);
+
+    /// The drained elastic displacement under constant nodal `loads` (N) with every prescribed
+    /// component at zero (a rest state), balanced as a call's loads are on unheld pieces.
+    std::vector<Vec3> drained_displacement(const std::vector<Vec3>& loads);
+
     /// Boundary values from the next call on (time tables, docs/method.md §5.3): nodal loads that
     /// replace the problem's nodal_force, and the values of the already prescribed displacement
     /// components and drained pressures (an empty array leaves those unchanged).

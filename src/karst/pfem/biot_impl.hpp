@@ -26,6 +26,7 @@ struct BiotSolver::Impl {
     Vector f_body;                  // body force
     Vector f_problem;  // body force + the nodal loads of the boundary (the problem's at first)
     Vector f_extra;    // set_extra_loads
+    Vector f_rest;     // K u_rest of set_rest_displacement (zero without one)
     Vector u_prescribed, p_prescribed;
 
     DofSplit u_dofs{{}}, p_dofs{{}};

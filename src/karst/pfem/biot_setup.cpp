@@ -303,13 +303,14 @@ void append_arrays(PointSet& into, const PointSet& local) {
 }
 
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
-                       const BiotFields& fields, const std::vector<Vec3>& support_force,
-                       const PorousMaterial& material, const std::vector<Mat3>& node_tensors,
-                       bool feedback) {
+                       const BiotFields& fields, const BiotFields& carried,
+                       const std::vector<Vec3>& support_force, const PorousMaterial& material,
+                       const std::vector<Mat3>& node_tensors, bool feedback) {
     const Index offset = Index(frame.nodes.x.size());
     const Index n = mesh.node_count();
-    const NodalStress stress = nodal_stress(mesh, problem.material, fields);
-    const NodalPoreState pore = nodal_pore_state(material, problem.material, stress, fields.p);
+    const NodalPoreState pore = nodal_pore_state(
+        material, problem.material, nodal_stress(mesh, problem.material, fields), fields.p);
+    const NodalStress stress = nodal_stress(mesh, problem.material, carried);
     std::vector<Real> crack(n);
     std::vector<Mat3> permeability(n);
     for (Index a = 0; a < n; ++a) {

@@ -65,7 +65,9 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     const BiotProblem& problem = solver_of(model, state, slot).problem();
     const std::vector<Index> index_of = index_by_id(p, st.node_of.size());
 
-    NodalStress stress = nodal_stress(s.mesh, problem.material, s.fields);
+    // The stress includes that of the rest state under the solid's weight: a crack or a loss of
+    // support leaves it unbalanced, and a part the rest state held may then break off.
+    NodalStress stress = nodal_stress(s.mesh, problem.material, fields_with_weight(st, s));
     // No crack starts at a node whose particle is gone, nor at an anchored node: the stress there
     // is the concentration of an idealised clamp, and a crack through the clamped layer would
     // leave both halves held.
@@ -148,6 +150,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         st.rest_volume[node_id[k]] = st.rest_volume[parent];
         st.paired_volume[node_id[k]] = st.paired_volume[parent];
         st.impulse[node_id[k]] = st.impulse[parent];
+        st.weight_u[node_id[k]] = st.weight_u[parent];
     }
     const std::vector<Index> particle = index_by_id(p, st.node_of.size());
     // The mesh holds a node where it was before any split (below), rest_x where its particle

@@ -97,6 +97,7 @@ void join_anchored(State& state, Index from, Index into) {
         p.body_permeability[k] = R.transpose() * p.permeability[k] * R;
         const Index id = p.id[k];
         st.rest_x[id] = p.x[k], st.u[id] = Vec3::Zero(), st.impulse[id] = Vec3::Zero();
+        st.weight_u[id] = Vec3::Zero();  // its weight is a new load on the structure
         st.rest_tensor[id] = p.body_permeability[k], st.rest_volume[id] = p.volume[k];
         st.paired_scale[id] = 1, st.paired_volume[id] = p.volume[k];
     }

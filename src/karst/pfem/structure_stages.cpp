@@ -31,19 +31,52 @@ std::vector<Index> index_by_id(const PorousParticles& p, size_t ids) {
     return index;
 }
 
+namespace {
+
+/// Per node of structure s, the value of its particle id in the per-id array `by_id`.
+std::vector<Vec3> node_values(const std::vector<Vec3>& by_id, const Structure& s) {
+    std::vector<Vec3> values(s.node_id.size());
+    for (size_t a = 0; a < s.node_id.size(); ++a) values[a] = by_id[s.node_id[a]];
+    return values;
+}
+
+/// The weight of each node's particle, its solid and its pore water (N); a node whose particle
+/// is gone weighs nothing.
+std::vector<Vec3> node_weights(const Model& model, const State& state, const Structure& s,
+                               const std::vector<Index>& index_of) {
+    const PorousParticles& p = state.porous.particles;
+    std::vector<Vec3> weight(s.node_id.size(), Vec3::Zero());
+    for (size_t a = 0; a < s.node_id.size(); ++a)
+        if (const Index i = index_of[s.node_id[a]]; i >= 0)
+            weight[a] = (p.solid_mass[i] + p.absorbed_mass[i]) * model.scene.gravity;
+    return weight;
+}
+
+}  // namespace
+
+BiotFields fields_with_weight(const StructureState& st, const Structure& s) {
+    BiotFields fields = s.fields;
+    for (size_t a = 0; a < fields.u.size(); ++a) fields.u[a] += st.weight_u[s.node_id[a]];
+    return fields;
+}
+
 BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     Structure& s = state.structures.structures[slot];
     if (BiotCache::Entry* e = state.biot_cache.find(slot, s.mesh_version)) return *e->solver;
     const PorousSolid& solid = model.scene.porous_solids[s.solid];
     BiotProblem problem = biot_problem(model, solid, s.mesh, s.node_tensors);
     // [D] Geostatic start in a coupled run: a fragment's rest state is its state at rest under
-    // its own weight, so gravity (body force and gravity flux) leaves the problem and u, eps_v
-    // and p are the response to the fluid's loads and to the pore overpressure P^p (M5, zero up
-    // to S = 1). With gravity in, a resting block of E = 1 MPa soil consolidated under its own
-    // weight at t = 0, and its porosity fell and its pore pressure rose before any water
-    // arrived. Biot is linear, so dropping a constant load only shifts the reference state. A
-    // poroelastic-only solid keeps gravity: consolidation under its weight is what it shows.
-    if (!model.poroelastic_only()) problem.gravity = Vec3::Zero();
+    // its own weight, so u, eps_v and p are measured from it. With gravity in the problem, a
+    // resting block of E = 1 MPa soil consolidated under its own weight at t = 0, and its
+    // porosity fell and its pore pressure rose before any water arrived. So gravity (body force
+    // and gravity flux) leaves the problem; the weight comes back as the particles' weight
+    // (solid and pore water) in each call's loads, held by the rest state's elastic forces
+    // K u_rest: they cancel while nothing changes, and what is left is the weight of the water
+    // absorbed since, of material dissolved, or the load a crack or a lost support no longer
+    // carries. A poroelastic-only solid keeps gravity: consolidation under its weight is what
+    // it shows.
+    const bool coupled = !model.poroelastic_only();
+    if (coupled) problem.gravity = Vec3::Zero();
     std::optional<BiotSplitOf> split_of;
     if (BiotCache::Entry* older =
             s.split_of_version >= 0 ? state.biot_cache.find(slot, s.split_of_version) : nullptr)
@@ -54,6 +87,7 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     BiotCache::Entry& e = state.biot_cache.reset(slot);
     e.solver.emplace(std::move(solver));
     e.mesh_version = s.mesh_version;
+    if (coupled) e.solver->set_rest_displacement(node_values(state.structures.weight_u, s));
     // The flow matrix the run was using: a new mesh starts from the problem's (scale 1); a solver
     // rebuilt for a mesh it had already (a resumed run) takes the scales it was assembled with.
     if (s.mobility_scale.size() != size_t(s.mesh.tet_count()))
@@ -71,7 +105,9 @@ namespace {
 
 /// Meshes structure `slot` on the rest positions of its fragment's present particles; u is
 /// carried per particle id, p starts at the drained pressure where drained and 0 elsewhere.
-void build(const Model& model, State& state, size_t slot) {
+/// With `new_rest_state` (a coupled run), the rest state is the new mesh standing under its
+/// particles' weight; otherwise each particle keeps its own (weight_u).
+void build(const Model& model, State& state, size_t slot, bool new_rest_state) {
     StructureState& st = state.structures;
     Structure& s = st.structures[slot];
     const PorousParticles& p = state.porous.particles;
@@ -101,7 +137,14 @@ void build(const Model& model, State& state, size_t slot) {
     }
     s.u_from = s.fields.u;
     s.distorted = false, s.grown = false;
-    const BiotProblem& problem = solver_of(model, state, slot).problem();
+    BiotSolver& solver = solver_of(model, state, slot);
+    if (new_rest_state && !model.poroelastic_only()) {
+        const std::vector<Vec3> u_rest = solver.drained_displacement(
+            node_weights(model, state, s, index_by_id(state.porous.particles, st.u.size())));
+        for (Index a = 0; a < n; ++a) st.weight_u[s.node_id[a]] = u_rest[a];
+        solver.set_rest_displacement(u_rest);
+    }
+    const BiotProblem& problem = solver.problem();
     for (Index a = 0; a < n; ++a)
         if (problem.drained[a])
             s.fields.p[a] = problem.drained_pressure.empty() ? 0 : problem.drained_pressure[a];
@@ -151,7 +194,7 @@ void build_structures(const Model& model, State& state) {
         Structure s;
         s.fragment = Index(f), s.solid = material;
         st.structures.push_back(std::move(s));
-        build(model, state, st.structures.size() - 1);
+        build(model, state, st.structures.size() - 1, true);
     }
 }
 
@@ -205,11 +248,13 @@ void remesh_structures(const Model& model, State& state) {
         const Index n = s.mesh.node_count();
         Index lost = 0;
         for (Index a = 0; a < n; ++a) lost += index_of[s.node_id[a]] < 0;
+        bool new_rest_state = false;
         if (lost > k_remesh_lost_fraction * n) {
             for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
         } else if (s.grown) {
             for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
         } else if (s.distorted) {
+            new_rest_state = true;
             // [D] A distorted mesh is rebuilt on the deformed positions, which become the new
             // rest state (u = 0 there): small-strain Biot cannot carry a deformation that inverts
             // elements, so the stress it held is released, as in a soil that has flowed.
@@ -224,7 +269,7 @@ void remesh_structures(const Model& model, State& state) {
         } else {
             continue;
         }
-        build(model, state, slot);
+        build(model, state, slot, new_rest_state);
         ++st.timings.remeshes;
     }
 }
@@ -240,11 +285,14 @@ void solve_structures(const Model& model, State& state, Real time, bool again) {
         BiotSolver& solver = solver_of(model, state, slot);
         const PoreWaterLaw& law = model.pore_laws[s.solid];
         const std::vector<char>& drained = solver.problem().drained;
-        std::vector<Vec3> loads(s.mesh.node_count(), Vec3::Zero());
+        // In a coupled run, the weight against the rest state's K u_rest (solver_of).
+        std::vector<Vec3> loads = model.poroelastic_only()
+                                      ? std::vector<Vec3>(s.mesh.node_count(), Vec3::Zero())
+                                      : node_weights(model, state, s, index_of);
         for (Index a = 0; a < s.mesh.node_count(); ++a) {
             const Index i = index_of[s.node_id[a]];
             if (i < 0) continue;
-            loads[a] = st.impulse[s.node_id[a]] / dt;
+            loads[a] += st.impulse[s.node_id[a]] / dt;
             if (from_pore_water && !drained[a])
                 s.fields.p[a] = law.pore_pressure(
                     law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]));
@@ -340,8 +388,9 @@ void append_structure_meshes(const Model& model, State& state, MeshFrame& frame)
     for (size_t slot = 0; slot < state.structures.structures.size(); ++slot) {
         const Structure& s = state.structures.structures[slot];
         append_mesh_frame(frame, s.mesh, solver_of(model, state, slot).problem(), s.fields,
-                          s.support_force, model.scene.porous_solids[s.solid].material,
-                          s.node_tensors, model.scene.poroelastic.permeability_feedback);
+                          fields_with_weight(state.structures, s), s.support_force,
+                          model.scene.porous_solids[s.solid].material, s.node_tensors,
+                          model.scene.poroelastic.permeability_feedback);
     }
 }
 

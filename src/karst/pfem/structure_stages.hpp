@@ -17,6 +17,11 @@ std::vector<Index> index_by_id(const PorousParticles& p, size_t ids);
 /// the cache has none for the current mesh.
 BiotSolver& solver_of(const Model& model, State& state, size_t slot);
 
+/// The structure's fields with u measured from the unloaded mesh: u plus the displacement of
+/// the rest state under the solid's weight (StructureState::weight_u). Its stress is the one
+/// the solid carries.
+BiotFields fields_with_weight(const StructureState& st, const Structure& s);
+
 /// Meshes every anchored fragment of a permeable solid on its particles' rest positions and
 /// builds its Biot problem (t = 0).
 void build_structures(const Model& model, State& state);
@@ -38,7 +43,7 @@ Real time_to_next_biot_call(const Model& model, const State& state);
 
 /// §4.10: remeshes a structure that has lost over 1 % of its nodes (to dissolution or the
 /// domain), or whose last call left a distorted element (on its deformed shape, which becomes
-/// the new rest state).
+/// the new rest state, standing under its weight).
 void remesh_structures(const Model& model, State& state);
 
 /// One Biot call per structure over the time since the last (M22), ending at `time`: loaded by

@@ -77,7 +77,10 @@ struct StructureState {
     // Per porous particle id (PorousParticles::id); grow_ids() sizes them for new ids:
     std::vector<Vec3> impulse;  ///< sum of force dt since the last call, N s
     std::vector<Vec3> u;        ///< displacement carried over a remesh, m
-    std::vector<Vec3> rest_x;   ///< rest position X (world = body frame when anchored), m
+    /// In a coupled run: the displacement of the rest state under the solid's own weight, which
+    /// u is measured from (structure_stages.cpp), m. Zero in a poroelastic-only run.
+    std::vector<Vec3> weight_u;
+    std::vector<Vec3> rest_x;  ///< rest position X (world = body frame when anchored), m
     std::vector<std::pair<Index, Index>> node_of;  ///< (structure, node), or (-1, -1)
     std::vector<Mat3> rest_tensor;                 ///< K0 in the body frame, m^2
     std::vector<Real> rest_volume;                 ///< V0, the bulk volume at eps_v = 0, m^3
@@ -94,7 +97,8 @@ struct StructureState {
     void grow_ids(size_t ids) {
         if (ids <= u.size()) return;
         impulse.resize(ids, Vec3::Zero()), u.resize(ids, Vec3::Zero()),
-            rest_x.resize(ids, Vec3::Zero()), node_of.resize(ids, {-1, -1});
+            weight_u.resize(ids, Vec3::Zero()), rest_x.resize(ids, Vec3::Zero()),
+            node_of.resize(ids, {-1, -1});
         rest_tensor.resize(ids, Mat3::Zero()), rest_volume.resize(ids, 0),
             paired_scale.resize(ids, 1), paired_volume.resize(ids, 0), damage.resize(ids, 0);
     }

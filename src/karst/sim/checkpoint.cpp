@@ -87,7 +87,7 @@ void fields(Ar& ar, FractureCounts& f) {
 
 template <class Ar>
 void fields(Ar& ar, StructureState& s) {
-    ar(s.structures, s.impulse, s.u, s.rest_x, s.node_of, s.rest_tensor, s.rest_volume,
+    ar(s.structures, s.impulse, s.u, s.weight_u, s.rest_x, s.node_of, s.rest_tensor, s.rest_volume,
        s.paired_scale, s.paired_volume, s.damage, s.elapsed, s.next_mesh_version, s.timings,
        s.fracture, s.cracks);
 }
