@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 namespace karst {
 namespace {
@@ -120,6 +121,47 @@ TEST(Cracks, HydrostaticCompressionNeverCracks) {
     const Sample s(Vec3(0.6, 0.4, 0.5), Mat3::Identity(), -100 * k_strength * Mat3::Identity());
     EXPECT_LT(s.stress.principal[0][0], -99 * k_strength);
     EXPECT_TRUE(s.cracks().empty());
+    EXPECT_TRUE(s.cracks(CrackCriterion::ExtensionStrain).empty());
+}
+
+TEST(Cracks, TheExtensionStrainCracksTensionAtTheStrengthAndSplitsCompressionAlongTheLoad) {
+    constexpr auto strain = CrackCriterion::ExtensionStrain;
+    const Vec3 size(1.2, 0.3, 0.3);
+    for (const Mat3& turn : {Mat3(Mat3::Identity()), turned_30_about_two_axes()}) {
+        // Uniaxial tension: E eps_1 = sigma_1, as Rankine.
+        EXPECT_TRUE(Sample(size, turn, uniaxial(0.95 * k_strength)).cracks(strain).empty());
+        const std::vector<Crack> pulled =
+            Sample(size, turn, uniaxial(1.05 * k_strength)).cracks(strain);
+        ASSERT_FALSE(pulled.empty());
+        for (const Crack& c : pulled) {
+            EXPECT_LT(angle_deg(c.normal, turn * Vec3::UnitX()), 5);
+            EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
+        }
+        // Uniaxial compression q: the sides stretch by nu q / E, so it splits along the load
+        // once nu q exceeds sigma_t (nu = 0.25), where Rankine never cracks.
+        const Real q = k_strength / 0.25;
+        EXPECT_TRUE(Sample(size, turn, uniaxial(-0.95 * q)).cracks(strain).empty());
+        const Sample pressed(size, turn, uniaxial(-1.05 * q));
+        EXPECT_TRUE(pressed.cracks().empty());
+        const std::vector<Crack> split = pressed.cracks(strain);
+        ASSERT_FALSE(split.empty());
+        for (const Crack& c : split) {
+            EXPECT_GT(angle_deg(c.normal, turn * Vec3::UnitX()), 85);
+            EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
+        }
+    }
+}
+
+TEST(Cracks, ANodeCracksAtItsScaledStrength) {
+    const Sample s(Vec3(1.2, 0.3, 0.3), Mat3::Identity(), uniaxial(0.6 * k_strength));
+    std::vector<Index> ids(s.mesh.node_count());
+    std::iota(ids.begin(), ids.end(), Index(0));
+    CrackSettings weak = settings(k_strength);
+    EXPECT_TRUE(find_cracks(s.mesh, s.stress, ids, weak).empty());
+    weak.strength_scale.assign(s.mesh.node_count(), 0.5);
+    const std::vector<Crack> cracks = find_cracks(s.mesh, s.stress, ids, weak);
+    ASSERT_FALSE(cracks.empty());
+    for (const Crack& c : cracks) EXPECT_NEAR(c.stress_ratio, 1.2, 0.01);
 }
 
 TEST(Cracks, TheSeparationTensorCracksUniaxialTensionAtTheStrengthAndShearAt45Degrees) {

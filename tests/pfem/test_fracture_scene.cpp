@@ -255,13 +255,16 @@ TEST(FractureScene, InACoupledRunAnOverhangStandsInItsRestStateAndBreaksOffWhenT
     EXPECT_LT(fragments[big].centre[2], 0.1 - 0.05) << "its centre started at 0.1 m";
 }
 
-/// A free bar 1.2 m x 0.3 m x 0.3 m on a 0.1 m lattice, drained, with the given constraints.
-std::string free_bar(const std::string& constraints) {
+/// A free bar 1.2 m x 0.3 m x 0.3 m on a 0.1 m lattice, drained, with the given constraints
+/// (and material keys).
+std::string free_bar(const std::string& constraints, const std::string& material = "",
+                     Real youngs_modulus = 1e6) {
     return R"({
       "name": "ramp", "particle_spacing": 0.1, "gravity": [0, 0, 0], "poroelastic": { "time_step": 0.01 },
       "porous_solids": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [1.2, 0.3, 0.3] },
-        "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "biot_coefficient": 0.9,
-                      "tensile_strength": 1e5 },
+        "material": { "porosity": 0.3, "permeability": 1e-10, "biot_coefficient": 0.9,
+                      "tensile_strength": 1e5, "youngs_modulus": )" +
+           fmt::format("{}", youngs_modulus) + material + R"( },
         "constraints": [ )" +
            constraints + R"( ] } ]
     })";
@@ -287,6 +290,29 @@ TEST(FractureScene, ABarUnderARampedTractionCracksAtItsStrengthNormalToTheLoad) 
     EXPECT_LE(t, 1.05);
     for (const CrackRecord& c : sim.state.structures.cracks)
         EXPECT_GT(std::abs(c.normal[0]), std::cos(5 * std::numbers::pi / 180));
+}
+
+TEST(FractureScene, WaterWeakensTheBarLinearlyWithItsSaturationToItsWetStrength) {
+    // The ramp of the test above on bars at S = 1 and S = 0.5 with a wet strength half the dry
+    // one: they crack at 0.5 and 0.75 of the dry strength. The bars are stiff, so that their
+    // stretch hardly lowers S (at E = 1 MPa the stretched pores held 10 % less).
+    const std::string ramp = R"(
+      { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
+      { "kind": "traction", "traction": [-1e5, 0, 0], "table": [[0, 0], [2, 2]],
+        "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+      { "kind": "traction", "traction": [1e5, 0, 0], "table": [[0, 0], [2, 2]],
+        "region": { "type": "box", "min": [1.2, -1, -1], "max": [2, 2, 2] } })";
+    for (const Real saturation : {1.0, 0.5}) {
+        test::Simulation sim(free_bar(
+            ramp,
+            fmt::format(R"(, "tensile_strength_wet": 5e4, "initial_saturation": {})", saturation),
+            1e8));
+        const Real expected = 1 - 0.5 * saturation;
+        const Real t = first_crack_time(sim, 2);
+        ASSERT_GT(t, 0) << "S = " << saturation;
+        EXPECT_GE(t, 0.95 * expected) << "S = " << saturation;
+        EXPECT_LE(t, 1.05 * expected) << "S = " << saturation;
+    }
 }
 
 TEST(FractureScene, RaisingThePorePressureAloneCracksWhenBTimesPReachesTheStrength) {

@@ -80,16 +80,23 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
     const std::vector<std::pair<Real, Vec3>> separation_test =
         separation ? separation_tensor_ratios(mesh, stress, settings.tensile_strength)
                    : std::vector<std::pair<Real, Vec3>>{};
+    const bool strain = settings.criterion == CrackCriterion::ExtensionStrain;
+    const Real nu = settings.poisson_ratio;
     for (Index a = 0; a < mesh.node_count(); ++a) {
-        Real ratio = separation ? separation_test[a].first
-                                : stress.principal[a][0] / settings.tensile_strength;
+        const Vec3& s = stress.principal[a];
+        const Real first = strain ? s[0] - nu * (s[1] + s[2]) : s[0];  // E eps_1 or sigma'_1
+        Real ratio = separation ? separation_test[a].first : first / settings.tensile_strength;
         Vec3 n = separation ? separation_test[a].second
                             : Vec3(stress.principal_direction[a].normalized());
         if (!settings.layer_normal.empty()) {
             const Vec3& m = settings.layer_normal[a];
-            const Real across = m.dot(stress.effective[a] * m) / settings.strength_across;
+            const Real normal = m.dot(stress.effective[a] * m);
+            const Real across =
+                (strain ? normal - nu * (stress.effective[a].trace() - normal) : normal) /
+                settings.strength_across;
             if (across > ratio) ratio = across, n = m;
         }
+        if (!settings.strength_scale.empty()) ratio /= settings.strength_scale[a];
         if (!(ratio > 1)) continue;
         Crack c;
         c.node = a, c.centre = mesh.nodes[a], c.stress_ratio = ratio;

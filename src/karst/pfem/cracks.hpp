@@ -3,6 +3,7 @@
 // (§5.6): pure functions of the mesh and its nodal stresses, so they can be tested alone.
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/structure_state.hpp"
+#include "karst/scene/scene.hpp"
 
 #include <functional>
 #include <span>
@@ -19,10 +20,6 @@ struct Crack {
     Real stress_ratio = 0;        ///< sigma'_1 / sigma_t
 };
 
-/// Which nodes crack (docs/method.md §5.5): Rankine on the nodal effective stress (M25), or
-/// O'Brien & Hodgins' separation tensor from the elements' nodal forces.
-enum class CrackCriterion { Rankine, SeparationTensor };
-
 struct CrackSettings {
     CrackCriterion criterion = CrackCriterion::Rankine;
     Real tensile_strength = 1e5;  ///< sigma_t, Pa
@@ -34,6 +31,9 @@ struct CrackSettings {
     /// across the layers (a crack along a layer opens when n . sigma' n exceeds it). Empty: none.
     std::vector<Vec3> layer_normal;
     Real strength_across = 1e5;  ///< Pa
+    Real poisson_ratio = 0.25;   ///< nu of the extension strain
+    /// Per node: its strengths over the material's (wet weakening, fracture_stage.cpp). Empty: 1.
+    std::vector<Real> strength_scale;
 };
 
 /// O'Brien & Hodgins 1999 at each node a: the element forces f_e = -V_e sigma'_e grad N_a, split
@@ -51,7 +51,12 @@ std::vector<std::pair<Real, Vec3>> separation_tensor_ratios(const TetMesh& mesh,
 
 /// M25: nodes whose largest effective principal stress exceeds sigma_t (or, with weak layers,
 /// whose normal stress across the layers exceeds the strength across them: a crack along the
-/// layer, whichever ratio is larger), in decreasing stress ratio (ties by the node's particle id,
+/// layer, whichever ratio is larger). With CrackCriterion::ExtensionStrain (Stacey 1981), the
+/// largest principal strain E eps_1 = sigma'_1 - nu (sigma'_2 + sigma'_3) takes the place of
+/// sigma'_1 (and the strain across the layers that of the stress across them): the same in
+/// uniaxial tension, but a bar in uniaxial compression splits along the load once nu times the
+/// compression exceeds sigma_t, as brittle rock and soil do. Each node's ratios are divided by
+/// its strength_scale. In decreasing ratio (ties by the node's particle id,
 /// so the order of the particles does not matter), skipping nodes within `exclusion` of a crack
 /// already taken and cracks for which `accept` (when given) is false, at most `max_cracks`.
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,

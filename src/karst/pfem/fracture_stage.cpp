@@ -79,8 +79,21 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     settings.fracture_energy = material.fracture_energy;
     settings.spacing = model.dx, settings.exclusion = model.h;
     settings.max_cracks = model.scene.fracture.max_cracks_per_call;
-    if (model.scene.fracture.separation_tensor)
-        settings.criterion = CrackCriterion::SeparationTensor;
+    settings.criterion = model.scene.fracture.criterion;
+    settings.poisson_ratio = material.poisson_ratio;
+    if (material.tensile_strength_wet) {
+        // [D] Water weakens rock and soil (wet sandstone keeps about half its strength; a soil
+        // loses the cohesion its suction gave it): the strengths fall linearly with saturation
+        // to the wet one at S = 1.
+        const Real wet = *material.tensile_strength_wet / material.tensile_strength;
+        const PoreWaterLaw& law = model.pore_laws[s.solid];
+        settings.strength_scale.assign(s.mesh.node_count(), 1);
+        for (Index a = 0; a < s.mesh.node_count(); ++a)
+            if (const Index i = index_of[s.node_id[a]]; i >= 0)
+                settings.strength_scale[a] =
+                    1 + (wet - 1) * std::min<Real>(1, law.saturation(p.absorbed_mass[i],
+                                                                     p.porosity[i], p.volume[i]));
+    }
     if (material.strength_across) {
         settings.strength_across = *material.strength_across;
         settings.layer_normal = layer_normals(s.node_tensors, material.layering_ratio);

@@ -146,6 +146,8 @@ Scene parse_scene(const std::string& text) {
         mat.solid_density = m["solid_density"], mat.youngs_modulus = m["youngs_modulus"];
         mat.poisson_ratio = m["poisson_ratio"], mat.biot_coefficient = m["biot_coefficient"];
         mat.tensile_strength = m["tensile_strength"], mat.fracture_energy = m["fracture_energy"];
+        if (m.contains("tensile_strength_wet"))
+            mat.tensile_strength_wet = m["tensile_strength_wet"].get<Real>();
         mat.capillary_pressure = m["capillary_pressure"],
         mat.capillary_exponent = m["capillary_exponent"];
         mat.pore_stiffness = m["pore_stiffness"],
@@ -235,8 +237,10 @@ Scene parse_scene(const std::string& text) {
     s.poroelastic.permeability_feedback = pe["permeability_feedback"];
     s.fracture.enabled = doc["fracture"]["enabled"],
     s.fracture.max_cracks_per_call = doc["fracture"]["max_cracks_per_call"];
-    s.fracture.separation_tensor = option<bool>(doc["fracture"]["criterion"],
-                                                {{"rankine", false}, {"separation_tensor", true}});
+    s.fracture.criterion = option<CrackCriterion>(
+        doc["fracture"]["criterion"], {{"rankine", CrackCriterion::Rankine},
+                                       {"separation_tensor", CrackCriterion::SeparationTensor},
+                                       {"extension_strain", CrackCriterion::ExtensionStrain}});
     s.fracture.merge = doc["fracture"]["merge"];
     s.fracture.merge_saturation = doc["fracture"]["merge_saturation"];
     s.fracture.merge_speed = doc["fracture"]["merge_speed"];

@@ -62,8 +62,10 @@ struct PorousMaterial {
     Real solid_density{};    ///< rho_s, kg/m^3
     Real youngs_modulus{};   ///< E (drained), Pa
     Real poisson_ratio{};
-    Real biot_coefficient{};     ///< B
-    Real tensile_strength{};     ///< sigma_t, Pa
+    Real biot_coefficient{};  ///< B
+    Real tensile_strength{};  ///< sigma_t, Pa
+    /// sigma_t of the saturated material (S = 1), Pa; absent: sigma_t at every saturation.
+    std::optional<Real> tensile_strength_wet;
     Real fracture_energy{};      ///< G_c (M26), J/m^2
     Real capillary_pressure{};   ///< k^c, Pa
     Real capillary_exponent{};   ///< alpha
@@ -147,13 +149,17 @@ struct PoroelasticSettings {
     bool weighted_alpha{};
 };
 
+/// Which nodes crack (docs/method.md §5.5): Rankine on the effective stress (M25), O'Brien &
+/// Hodgins' separation tensor, or Stacey's extension strain.
+enum class CrackCriterion { Rankine, SeparationTensor, ExtensionStrain };
+
 struct FractureSettings {
     bool enabled{};
     int max_cracks_per_call{};  ///< N_crack
-    bool separation_tensor{};   ///< O'Brien & Hodgins' criterion instead of Rankine (M25)
-    bool merge{};               ///< wet fragments in slow contact join (§5.6)
-    Real merge_saturation{};    ///< S_merge: mean saturation of the contact particles
-    Real merge_speed{};         ///< v_merge: largest closing speed of a contact pair, m/s
+    CrackCriterion criterion{};
+    bool merge{};             ///< wet fragments in slow contact join (§5.6)
+    Real merge_saturation{};  ///< S_merge: mean saturation of the contact particles
+    Real merge_speed{};       ///< v_merge: largest closing speed of a contact pair, m/s
 };
 
 /// The pictures of `karst render` (render/render.hpp); the camera is framed on the surfaces

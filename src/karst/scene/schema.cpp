@@ -177,6 +177,11 @@ std::vector<KeySpec> make_schema() {
         key("/porous_solids/[]/material/tensile_strength", T::Number, "Pa", positive(1e12), 1e5,
             "Tensile strength sigma_t of the Rankine test (M25): a node whose largest effective "
             "principal stress exceeds it cracks (with /fracture/enabled)."),
+        optional("/porous_solids/[]/material/tensile_strength_wet", T::Number, "Pa", positive(1e12),
+                 "The tensile strength of the saturated material: water weakens rock and soil, "
+                 "so the strengths (tensile_strength and tensile_strength_across) fall linearly "
+                 "with the saturation S to this one at S = 1 (docs/method.md M25). Absent: no "
+                 "weakening."),
         key("/porous_solids/[]/material/fracture_energy", T::Number, "J/m^2", positive(1e12), 10.0,
             "Critical energy-release rate G_c (M26): a crack's area is the node's strain energy "
             "over G_c (its radius clamped to 0.5-3 spacings)."),
@@ -355,8 +360,11 @@ std::vector<KeySpec> make_schema() {
             "rankine: a node cracks when its largest effective principal stress exceeds the "
             "tensile strength (M25); separation_tensor: O'Brien & Hodgins' separation tensor of "
             "the elements' tensile and compressive nodal forces, scaled so that uniaxial tension "
-            "cracks at the same strength (docs/method.md §5.5).",
-            {"rankine", "separation_tensor"}),
+            "cracks at the same strength (docs/method.md §5.5); extension_strain: Stacey's "
+            "criterion, the largest principal strain over tensile_strength / E (the same in "
+            "uniaxial tension; a solid in compression splits along the load once Poisson's "
+            "ratio times the compression exceeds the strength).",
+            {"rankine", "separation_tensor", "extension_strain"}),
         key("/fracture/merge", T::Bool, "", any(), true,
             "Fragments that touch while wet join again (docs/method.md §5.6): the mean saturation "
             "of their touching particles at least merge_saturation, every touching pair closing "
