@@ -126,18 +126,30 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
     return taken;
 }
 
-std::vector<Index> links_cut(const TetMesh& mesh, std::span<const ElementLink> links,
-                             std::span<const Crack> cracks) {
+std::vector<LinkGeometry> link_geometry(const TetMesh& mesh, std::span<const ElementLink> links) {
+    std::vector<LinkGeometry> geometry(links.size());
+    for (size_t k = 0; k < links.size(); ++k) {
+        LinkGeometry& g = geometry[k];
+        g.a = centroid(mesh, links[k].a), g.b = centroid(mesh, links[k].b);
+        g.face = shared_face_centroid(mesh, links[k]);
+        g.reach2 = std::max((g.a - g.face).squaredNorm(), (g.b - g.face).squaredNorm());
+    }
+    return geometry;
+}
+
+std::vector<Index> links_cut(std::span<const LinkGeometry> links, std::span<const Crack> cracks) {
     std::vector<Index> cut(links.size(), -1);
     if (cracks.empty()) return cut;
     for (size_t k = 0; k < links.size(); ++k) {
-        const Vec3 ca = centroid(mesh, links[k].a), cb = centroid(mesh, links[k].b);
-        const Vec3 face = shared_face_centroid(mesh, links[k]);
+        const LinkGeometry& l = links[k];
         for (size_t m = 0; m < cracks.size(); ++m) {
             const Crack& c = cracks[m];
-            const Real sa = (ca - c.centre).dot(c.normal), sb = (cb - c.centre).dot(c.normal);
+            const Vec3 r = l.face - c.centre;
+            // A plane between the centroids passes within reach of the face's centroid, so a
+            // face farther than radius and reach from the centre is not cut: a cheap first test.
+            if (r.squaredNorm() > c.radius * c.radius + l.reach2) continue;
+            const Real sa = (l.a - c.centre).dot(c.normal), sb = (l.b - c.centre).dot(c.normal);
             if (!((sa < 0 && sb > 0) || (sa > 0 && sb < 0))) continue;
-            const Vec3 r = face - c.centre;
             if ((r - r.dot(c.normal) * c.normal).squaredNorm() < c.radius * c.radius) {
                 cut[k] = Index(m);
                 break;

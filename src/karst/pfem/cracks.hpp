@@ -63,10 +63,21 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                                std::span<const Index> node_id, const CrackSettings& settings,
                                const std::function<bool(const Crack&)>& accept = {});
 
+/// Per link: the centroids of its two tets and of the face they share, what links_cut reads, and
+/// the larger squared distance from the face's centroid to the tets'.
+struct LinkGeometry {
+    Vec3 a, b, face;
+    Real reach2 = 0;  ///< m^2
+};
+std::vector<LinkGeometry> link_geometry(const TetMesh& mesh, std::span<const ElementLink> links);
+
 /// §5.6: per link, the first crack whose disk cuts the face the link stands for (-1: none): the
 /// two centroids lie on opposite sides of the crack plane and the shared face's centroid within
 /// the disk's radius of its axis.
-std::vector<Index> links_cut(const TetMesh& mesh, std::span<const ElementLink> links,
-                             std::span<const Crack> cracks);
+std::vector<Index> links_cut(std::span<const LinkGeometry> links, std::span<const Crack> cracks);
+inline std::vector<Index> links_cut(const TetMesh& mesh, std::span<const ElementLink> links,
+                                    std::span<const Crack> cracks) {
+    return links_cut(link_geometry(mesh, links), cracks);
+}
 
 }  // namespace karst

@@ -99,12 +99,13 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         settings.layer_normal = layer_normals(s.node_tensors, material.layering_ratio);
     }
     // A crack whose disk cuts no unbroken link (the crack is already there) does not count.
+    const std::vector<LinkGeometry> link_at = link_geometry(s.mesh, s.links);
     const auto cuts_something = [&](const Crack& c) {
-        const std::vector<Index> cut = links_cut(s.mesh, s.links, std::span(&c, 1));
+        const std::vector<Index> cut = links_cut(link_at, std::span(&c, 1));
         return std::any_of(cut.begin(), cut.end(), [](Index k) { return k >= 0; });
     };
     std::vector<Crack> cracks = find_cracks(s.mesh, stress, s.node_id, settings, cuts_something);
-    const std::vector<Index> cutter = links_cut(s.mesh, s.links, cracks);
+    const std::vector<Index> cutter = links_cut(link_at, cracks);
     std::vector<Index> links_broken(cracks.size(), 0);
     std::vector<char> cut(cutter.size(), 0);
     for (size_t k = 0; k < cutter.size(); ++k) cut[k] = cutter[k] >= 0;
