@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 
 namespace karst {
 
@@ -308,9 +309,12 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
                        const std::vector<Mat3>& node_tensors, bool feedback) {
     const Index offset = Index(frame.nodes.x.size());
     const Index n = mesh.node_count();
-    const NodalPoreState pore = nodal_pore_state(
-        material, problem.material, nodal_stress(mesh, problem.material, fields), fields.p);
     const NodalStress stress = nodal_stress(mesh, problem.material, carried);
+    // The pores follow the strain of u alone: another stress only where a rest state adds to u.
+    std::optional<NodalStress> own;
+    if (carried.u != fields.u) own = nodal_stress(mesh, problem.material, fields);
+    const NodalPoreState pore =
+        nodal_pore_state(material, problem.material, own ? *own : stress, fields.p);
     std::vector<Real> crack(n);
     std::vector<Mat3> permeability(n);
     for (Index a = 0; a < n; ++a) {
