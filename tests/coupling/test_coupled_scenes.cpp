@@ -145,6 +145,35 @@ TEST(Coupling, AThinPlateDroppedOnTheFloorRestsWithoutGainingEnergy) {
         << "on the floor (its members rest a spacing above the wall particles at -dx/2)";
 }
 
+// A 1000-member block dropped 4 cm beside a one-member crumb: the contact law of the lightest
+// fragment (the crumb's, ten times softer per face) let the block sink a tenth of a spacing into
+// the floor at rest, and through it on a harder landing. Each fragment has its own law: the block
+// rests where the plate does, and nothing gains energy.
+TEST(Coupling, ABlockBesideACrumbRestsOnTheFloorAtItsOwnContactStiffness) {
+    test::Simulation sim(R"({
+      "name": "block_and_crumb", "particle_spacing": 0.02, "time": { "fixed_dt": 0.002 },
+      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.4] } } ],
+      "porous_solids": [
+        { "shape": { "type": "box", "min": [0.04, 0.04, 0.04], "max": [0.24, 0.24, 0.24] },
+          "anchored": false, "material": { "porosity": 0, "solid_density": 2000 } },
+        { "shape": { "type": "box", "min": [0.32, 0.32, 0.0], "max": [0.34, 0.34, 0.02] },
+          "anchored": false, "material": { "porosity": 0, "solid_density": 2000 } } ]
+    })");
+    ASSERT_EQ(sim.state.porous.size(), 1001);
+    const Real e0 = mechanical_energy(sim.model, sim.state).total();
+    Real highest = e0;
+    sim.run_until(
+        1.0, [&] { highest = std::max(highest, mechanical_energy(sim.model, sim.state).total()); });
+    EXPECT_LE(highest, e0) << "J";
+    const PorousParticles& p = sim.state.porous.particles;
+    std::vector<Vec3> block;
+    for (Index i = 0; i < p.size(); ++i)
+        if (p.fragment[i] == 0) block.push_back(p.x[i]);
+    ASSERT_EQ(block.size(), 1000u);
+    EXPECT_LT(sim.state.porous.fragments[0].velocity.norm(), 1e-3) << "m/s: at rest";
+    EXPECT_NEAR(lowest(block), 0.5 * k_dx, 0.05 * k_dx) << "m: on the floor, not in it";
+}
+
 // No gravity, no fluid: a free fragment keeps its momentum, its angular momentum and its shape,
 // and its quaternion stays unit (docs/method.md §4.5).
 TEST(Coupling, FreeFragmentInVacuumConservesMomentumAndKeepsItsShape) {

@@ -41,7 +41,7 @@ std::string pulled_bar(bool fracture) {
 
 Real total_mechanical_energy(const test::Simulation& sim) {
     const Energy e = mechanical_energy(sim.model, sim.state);
-    return e.kinetic + e.potential;
+    return e.total();
 }
 
 struct Totals {
@@ -64,7 +64,8 @@ TEST(FractureScene, SplitsAndNewFragmentsKeepMassWaterAndMomentum) {
     sim.advance();  // one Biot call, not yet tested for cracks
     ASSERT_EQ(sim.state.structures.timings.biot_calls, 1);
     PorousParticles& p = sim.state.porous.particles;
-    // Give the particles a rigid motion plus a shear, so that momentum is not trivially zero.
+    // The particles of an anchored body move only as its quasi-static u does, here a rigid
+    // motion plus a shear: no momentum of a body (sim/energy.cpp), and none a piece may take.
     for (Index i = 0; i < p.size(); ++i)
         p.v[i] =
             Vec3(0.3, -0.2, 0.1) + Vec3(0.5, 1.0, -2.0).cross(p.x[i]) + Vec3(0, 0.4 * p.x[i][0], 0);
@@ -80,9 +81,8 @@ TEST(FractureScene, SplitsAndNewFragmentsKeepMassWaterAndMomentum) {
     const Totals after = totals(p);
     EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);
     EXPECT_NEAR(after.water, before.water, 1e-12 * before.water);
-    EXPECT_LT((after.momentum - before.momentum).norm(), 1e-12 * before.momentum.norm());
-    EXPECT_LT((after.angular - before.angular).norm(), 1e-12 * before.angular.norm());
-    // Every new fragment carries exactly its members' momentum, about its centre and in total.
+    // Every new fragment starts at rest (M27: the anchored body's rigid field is zero), and
+    // carries exactly its members' momentum, about its centre and in total: none.
     const auto& fragments = sim.state.porous.fragments;
     for (size_t f = 1; f < fragments.size(); ++f) {
         const Fragment& fr = fragments[f];
@@ -95,9 +95,10 @@ TEST(FractureScene, SplitsAndNewFragmentsKeepMassWaterAndMomentum) {
             m += mi, P += mi * p.v[i], L += mi * p.x[i].cross(p.v[i]);
         }
         EXPECT_NEAR(fr.mass, m, 1e-12 * m);
-        EXPECT_LT((fr.mass * fr.velocity - P).norm(), 1e-12 * P.norm() + 1e-15);
-        const Vec3 L_rigid = fr.mass * fr.centre.cross(fr.velocity) + fr.angular_momentum;
-        EXPECT_LT((L_rigid - L).norm(), 1e-12 * L.norm() + 1e-15);
+        EXPECT_EQ(fr.velocity, Vec3::Zero());
+        EXPECT_EQ(fr.angular_momentum, Vec3::Zero());
+        EXPECT_EQ(P, Vec3::Zero());
+        EXPECT_EQ(L, Vec3::Zero());
     }
     // The structure keeps the rest, on a mesh whose nodes are its particles.
     const Structure& s = sim.state.structures.structures.at(0);
@@ -255,6 +256,59 @@ TEST(FractureScene, InACoupledRunAnOverhangStandsInItsRestStateAndBreaksOffWhenT
     EXPECT_LT(fragments[big].centre[2], 0.1 - 0.05) << "its centre started at 0.1 m";
 }
 
+/// An arch on the floor of a box: two legs 0.1 m square and 0.3 m tall, 0.4 m apart, under a
+/// 0.1 m lintel, its weight's corner stress (about 16 kPa) three times its strength.
+std::string arch() {
+    return R"({
+      "name": "arch", "particle_spacing": 0.025, "poroelastic": { "time_step": 0.02 },
+      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [-0.2, -0.2, 0], "max": [0.8, 0.3, 0.6] } } ],
+      "porous_solids": [ { "shape": { "type": "union", "shapes": [
+            { "type": "box", "min": [0, 0, 0], "max": [0.1, 0.1, 0.3] },
+            { "type": "box", "min": [0.5, 0, 0], "max": [0.6, 0.1, 0.3] },
+            { "type": "box", "min": [0, 0, 0.3], "max": [0.6, 0.1, 0.4] } ] },
+        "material": { "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e7, "solid_density": 2000,
+                      "tensile_strength": 5e3, "fracture_energy": 1e-3 },
+        "constraints": [ { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } } ] } ]
+    })";
+}
+
+// A wall only pushes (fracture_stage.cpp): the arch breaks, and of the pieces standing on the
+// floor only the biggest stays clamped to it; the others are free fragments resting on the floor
+// by contact. Before, every piece touching the floor stayed clamped, so no column cut from a
+// block could slide or topple. The free pieces settle without sinking into the floor (each
+// fragment's own contact law) and without gaining energy.
+TEST(FractureScene, PiecesOfAnArchStandingOnTheFloorAreFreeFragmentsThatRestOnIt) {
+    test::Simulation sim(arch());
+    ASSERT_TRUE(sim.model.poroelastic_only());
+    const Real e0 = total_mechanical_energy(sim);
+    Real highest = e0;
+    sim.run_until(1.0, [&] { highest = std::max(highest, total_mechanical_energy(sim)); });
+    EXPECT_GE(sim.state.structures.fracture.fragments_created, 2);
+    // Issue 11's bound for impacts: never above the start by 2 % of what was released (about
+    // 1 J; the split copies, moved 5 % of a spacing apart, overlap the other side's particles by
+    // a few per cent of a spacing, and the springs give the pieces 0.01 J at birth).
+    const Real released = e0 - total_mechanical_energy(sim);
+    EXPECT_GT(released, 0.5) << "J";
+    EXPECT_LT(highest - e0, 0.02 * released) << "J";
+    const PorousParticles& p = sim.state.porous.particles;
+    const auto& fragments = sim.state.porous.fragments;
+    const Real dx = sim.model.dx;
+    std::vector<Real> lowest(fragments.size(), 1e9);
+    Real fastest = 0;
+    for (Index i = 0; i < p.size(); ++i) {
+        lowest[p.fragment[i]] = std::min(lowest[p.fragment[i]], p.x[i][2]);
+        if (!fragments[p.fragment[i]].anchored) fastest = std::max(fastest, p.v[i].norm());
+    }
+    Index free_on_floor = 0;
+    for (size_t f = 0; f < fragments.size(); ++f) {
+        if (fragments[f].mass <= 0) continue;
+        EXPECT_GT(lowest[f], 0.0) << "m: fragment " << f << " sank over half a spacing";
+        free_on_floor += !fragments[f].anchored && lowest[f] < dx;
+    }
+    EXPECT_GE(free_on_floor, 1) << "a leg cut from the clamped piece stands free on the floor";
+    EXPECT_LT(fastest, 0.3) << "m/s: the pieces have settled";
+}
+
 /// A free bar 1.2 m x 0.3 m x 0.3 m on a 0.1 m lattice, drained, with the given constraints
 /// (and material keys).
 std::string free_bar(const std::string& constraints, const std::string& material = "",
@@ -381,7 +435,7 @@ TEST(FractureScene, TheShippedCollapsingSceneBreaksIntoFragmentsWithoutGainingEn
     sim.run_until(sim.model.scene.time.end - 1e-9,
                   [&] { highest = std::max(highest, total_mechanical_energy(sim)); });
     EXPECT_GE(sim.state.structures.fracture.fragments_created, 2);
-    EXPECT_LT(highest, e0 * 1.001) << "kinetic + potential energy rose";
+    EXPECT_LT(highest, e0 * 1.001) << "kinetic + potential + elastic energy rose";
 }
 
 }  // namespace

@@ -181,7 +181,7 @@ TEST(PoroelasticScene, CliWritesMeshFramesListedInMeshCaseAndStats) {
     EXPECT_NE(pvd.find("part=\"3\" file=\"porous_0002.vtp\""), std::string::npos);
     const std::string vtp = read_text(out / "porous_0002.vtp");
     for (const char* array : {"saturation", "porosity", "absorbed_mass", "pore_pressure",
-                              "pore_velocity", "fragment", "permeability"})
+                              "pore_velocity", "fragment", "permeability", "velocity", "id"})
         EXPECT_NE(vtp.find(fmt::format("Name=\"{}\"", array)), std::string::npos) << array;
     const auto stats = nlohmann::json::parse(read_text(out / "stats.json"));
     EXPECT_EQ(stats["counts"]["porous"], 640);

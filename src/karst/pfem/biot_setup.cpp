@@ -204,6 +204,16 @@ std::vector<std::vector<Index>> unheld_pieces(const TetMesh& mesh,
     return unheld;
 }
 
+std::vector<std::uint8_t> constrained_axes(const Model& model, const PorousSolid& solid,
+                                           const TetMesh& mesh) {
+    std::vector<std::uint8_t> axes(mesh.node_count(), 0);
+    for (const Constraint& c : solid.constraints)
+        if (c.kind == Constraint::Kind::Fixed)
+            for (Index a = 0; a < mesh.node_count(); ++a)
+                if (on_region(model, c, mesh.nodes[a])) axes[a] |= c.axes;
+    return axes;
+}
+
 BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const TetMesh& mesh,
                          const std::vector<Mat3>& node_tensors) {
     BiotProblem p;
@@ -213,17 +223,11 @@ BiotProblem biot_problem(const Model& model, const PorousSolid& solid, const Tet
     for (Index e = 0; e < mesh.tet_count(); ++e)
         p.mobility[e] = tet_mean(mesh.tets[e], node_tensors) / solid.material.darcy_viscosity;
     const Index n = mesh.node_count();
-    p.fixed.assign(n, 0), p.drained.assign(n, 0);
+    p.fixed = constrained_axes(model, solid, mesh), p.drained.assign(n, 0);
     for (const Constraint& c : solid.constraints)
-        for (Index a = 0; a < n; ++a) {
-            if (c.kind == Constraint::Kind::Traction || c.kind == Constraint::Kind::Platen ||
-                !on_region(model, c, mesh.nodes[a]))
-                continue;
-            if (c.kind == Constraint::Kind::Fixed)
-                p.fixed[a] |= c.axes;
-            else
-                p.drained[a] = 1;
-        }
+        if (c.kind == Constraint::Kind::Drained)
+            for (Index a = 0; a < n; ++a)
+                if (on_region(model, c, mesh.nodes[a])) p.drained[a] = 1;
     for (Index a = 0; a < n; ++a)
         if (touches_wall(model, mesh.nodes[a])) p.fixed[a] = FixAll;
     for (const Constraint& c : solid.constraints) {

@@ -57,6 +57,11 @@ inline bool has_time_table(const PorousSolid& solid) {
 std::vector<std::vector<Index>> unheld_pieces(const TetMesh& mesh,
                                               std::span<const std::uint8_t> fixed);
 
+/// The axes each node of `mesh` is held on by the solid's `fixed` constraints (FixX | FixY |
+/// FixZ bits), not counting the walls' anchors.
+std::vector<std::uint8_t> constrained_axes(const Model& model, const PorousSolid& solid,
+                                           const TetMesh& mesh);
+
 /// The Biot problem of `solid` on `mesh`, whose nodes are world positions: mobility from the
 /// nodal tensors K0, the scene's constraints (fixed, drained, traction) at t = 0, and anchors
 /// where a node lies within a spacing of a static wall.

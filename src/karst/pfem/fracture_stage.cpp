@@ -1,5 +1,6 @@
 #include "karst/pfem/fracture_stage.hpp"
 
+#include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/cracks.hpp"
 #include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/rigid_modes.hpp"
@@ -109,19 +110,22 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     std::vector<Index> links_broken(cracks.size(), 0);
     std::vector<char> cut(cutter.size(), 0);
     for (size_t k = 0; k < cutter.size(); ++k) cut[k] = cutter[k] >= 0;
-    // A small piece whose fixed nodes hold it stays in the structure (the topology below): it is
-    // no fragment, and sparing it left a body hanging from a stub by links no crack could cut.
+    // A small piece that a `fixed` constraint holds stays in the structure (the topology below):
+    // it is no fragment, and sparing it left a body hanging from a stub by links no crack could
+    // cut. One held only by a wall would fall free, so it is spared.
+    const std::vector<std::uint8_t> constrained =
+        constrained_axes(model, model.scene.porous_solids[s.solid], s.mesh);
     const auto stays_anchored = [&](std::span<const Index> tets) {
         std::vector<Vec3> held_x;
         std::vector<std::uint8_t> held_axes;
         std::vector<Index> nodes;
         for (Index e : tets)
             for (Index a : s.mesh.tets[e])
-                if (problem.fixed[a]) nodes.push_back(a);
+                if (constrained[a]) nodes.push_back(a);
         std::sort(nodes.begin(), nodes.end());
         nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
         for (Index a : nodes)
-            held_x.push_back(s.mesh.nodes[a]), held_axes.push_back(problem.fixed[a]);
+            held_x.push_back(s.mesh.nodes[a]), held_axes.push_back(constrained[a]);
         return holds_rigid_modes(held_x, held_axes);
     };
     spare_small_pieces(s.mesh.tet_count(), s.links, cut, k_min_piece_tets, stays_anchored);
@@ -182,27 +186,40 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         p.volume[i] *= share, p.absorbed_mass[i] *= share, p.solid_mass[i] *= share;
     }
 
-    // Topology: components held by an anchor stay in the structure (with no anchor at all, the
-    // biggest one does); every other component becomes a free rigid fragment.
-    // A component is held when its fixed nodes hold all six rigid modes (one anchored node is a
-    // hinge, and a hinged piece falls).
+    // Topology: components held by a `fixed` constraint stay in the structure; every other
+    // component becomes a free rigid fragment. A component is held when its fixed nodes hold all
+    // six rigid modes (one anchored node is a hinge, and a hinged piece falls). [D] A wall only
+    // pushes: with no constraint holding any component, the biggest one resting on a wall stays
+    // (its clamp stands for the friction under a body), else the biggest; the pieces cut off it
+    // rest on the wall by contact, so they can slide and topple.
+    const auto held_components = [&](std::span<const std::uint8_t> fixed) {
+        std::vector<std::vector<Vec3>> held_x(split.components);
+        std::vector<std::vector<std::uint8_t>> held_axes(split.components);
+        std::vector<char> seen(split.mesh.node_count(), 0);
+        for (Index e = 0; e < split.mesh.tet_count(); ++e)
+            for (Index k : split.mesh.tets[e])
+                if (!seen[k] && fixed[split.source[k]])
+                    seen[k] = 1, held_x[split.component[e]].push_back(split.mesh.nodes[k]),
+                    held_axes[split.component[e]].push_back(fixed[split.source[k]]);
+        std::vector<char> held(split.components, 0);
+        for (Index c = 0; c < split.components; ++c)
+            held[c] = holds_rigid_modes(held_x[c], held_axes[c]);
+        return held;
+    };
     std::vector<Index> tets_in(split.components, 0);
-    std::vector<std::vector<Vec3>> held_x(split.components);
-    std::vector<std::vector<std::uint8_t>> held_axes(split.components);
-    std::vector<char> seen(split.mesh.node_count(), 0);
-    for (Index e = 0; e < split.mesh.tet_count(); ++e) {
-        const Index c = split.component[e];
-        ++tets_in[c];
-        for (Index k : split.mesh.tets[e])
-            if (!seen[k] && problem.fixed[split.source[k]])
-                seen[k] = 1, held_x[c].push_back(split.mesh.nodes[k]),
-                held_axes[c].push_back(problem.fixed[split.source[k]]);
+    for (Index e = 0; e < split.mesh.tet_count(); ++e) ++tets_in[split.component[e]];
+    const auto biggest_of = [&](const std::vector<char>& among) {
+        Index best = -1;
+        for (Index c = 0; c < split.components; ++c)
+            if (among[c] && (best < 0 || tets_in[c] > tets_in[best])) best = c;
+        return best;
+    };
+    std::vector<char> anchored = held_components(constrained);
+    if (biggest_of(anchored) < 0) {
+        Index stays = biggest_of(held_components(problem.fixed));
+        if (stays < 0) stays = biggest_of(std::vector<char>(split.components, 1));
+        anchored[stays] = 1;
     }
-    std::vector<char> anchored(split.components, 0);
-    for (Index c = 0; c < split.components; ++c)
-        anchored[c] = holds_rigid_modes(held_x[c], held_axes[c]);
-    if (std::none_of(anchored.begin(), anchored.end(), [](char c) { return c; }))
-        anchored[std::max_element(tets_in.begin(), tets_in.end()) - tets_in.begin()] = 1;
     std::vector<char> keep(split.mesh.tet_count());
     for (Index e = 0; e < split.mesh.tet_count(); ++e) keep[e] = anchored[split.component[e]];
 
@@ -217,7 +234,11 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     for (Index c = 0; c < split.components; ++c) {
         if (anchored[c] || members[c].empty()) continue;
         const Index f = Index(state.porous.fragments.size());
-        for (Index i : members[c]) p.fragment[i] = f;
+        // [D] The body's rigid field (M27) is zero: an anchored body does not move, its particles'
+        // velocities only spread a quasi-static call's u over dt_B (sim/energy.cpp counts them
+        // no kinetic energy). So a piece cut from it starts at rest; inheriting them gave an
+        // arch's pieces more kinetic energy than its weight and elasticity had released.
+        for (Index i : members[c]) p.fragment[i] = f, p.v[i] = Vec3::Zero();
         state.porous.fragments.push_back(free_fragment(p, members[c], model.dx));
         ++st.fracture.fragments_created;
     }

@@ -42,6 +42,8 @@ PointSet porous_points(const PorousParticles& p, std::span<const PoreWaterLaw> l
     points.add_scalar("pore_pressure", pore_pressure);
     points.add_vector("pore_velocity", velocity);
     points.add_integer("fragment", fragment);
+    points.add_vector("velocity", p.v);
+    points.add_integer("id", std::vector<std::int64_t>(p.id.begin(), p.id.end()));
     points.add_symmetric_tensor("permeability", p.permeability);
     return points;
 }

@@ -7,29 +7,47 @@
 #include "karst/porous/pore_water.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 
+#include <algorithm>
+#include <span>
+#include <vector>
+
 namespace karst {
 
 struct ContactLaw {
     Real rest_distance = 0.02;  ///< d0 = dx, m
     Real stiffness = 0;         ///< k_c, N/m
     Real damping = 0;           ///< c_c, N s/m
-    /// k_c = M g / (0.01 dx) for the lightest fragment M in contact (docs/method.md §4.2), and the
+    /// k_c = M g / (0.01 dx) for a fragment of mass M (docs/method.md §4.2), and the
     /// damping that gives a normal restitution e for two particles of mass m_pair each.
     static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity,
                                     Real particle_mass, Real restitution = 0.2);
+    /// Per fragment, the factor on k_c and c_c of its pairs: its own M / N^(2/3) over the one the
+    /// law was made for (0 for a fragment that does not move). Empty: 1 for every fragment.
+    std::vector<Real> scale;
+    /// The factor of a pair between fragments a and b (a wall: b = a): that of the lighter one
+    /// that moves (0 when neither does). The lighter one's own springs then give it the
+    /// frequency of its own law, so a crumb does not set the contact sub-steps of a block on it.
+    Real pair_scale(Index a, Index b) const {
+        if (scale.empty()) return 1;
+        const Real sa = scale[size_t(a)], sb = scale[size_t(b)];
+        return sa == 0 ? sb : sb == 0 ? sa : std::min(sa, sb);
+    }
     /// The spring on particle a from b at offset x = x_a - x_b with relative velocity
-    /// v = v_a - v_b (N), for 0 < |x| < d0.
-    Vec3 force(const Vec3& x, const Vec3& v) const {
+    /// v = v_a - v_b (N), for 0 < |x| < d0, times the pair's factor s.
+    Vec3 force(const Vec3& x, const Vec3& v, Real s = 1) const {
         const Real r = x.norm();
         const Vec3 n = x / r;
-        return (stiffness * (rest_distance - r) - damping * v.dot(n)) * n;
+        return (s * (stiffness * (rest_distance - r) - damping * v.dot(n))) * n;
     }
 };
 
 /// Adds the contact forces (N) into `force` (one per particle); `neighbours` lists particles
-/// within at least d0 (any fragment). Returns the number of touching pairs.
+/// within at least d0 (any fragment). Where `still_x` is given (one per particle), a particle of a
+/// fragment that does not move (scale 0) meets the others at still_x, at rest. Returns the
+/// number of touching pairs.
 Index add_contact_forces(const PorousParticles& particles, const NeighbourLists& neighbours,
-                         const ContactLaw& law, std::vector<Vec3>& force);
+                         const ContactLaw& law, std::vector<Vec3>& force,
+                         std::span<const Vec3> still_x = {});
 
 /// The same springs against static wall particles at `wall_x` (the walls take no reaction);
 /// `walls` lists, per porous particle, wall particles within at least d0. Returns the touching

@@ -12,21 +12,26 @@ namespace karst {
 
 namespace {
 
-/// The contact law of docs/method.md §4.2 for the lightest free fragment (mass M, N members).
+/// The contact law of docs/method.md §4.2, per free fragment (mass M, N members).
 /// [D] The sheet's k_c = M g / (0.01 dx) holds a fragment on one particle. A fragment resting on
 /// a face touches about N^(2/3) particles, which is N^(2/3) times stiffer: omega^2 = N^(2/3) g /
 /// (0.01 dx), so omega dt = 9 for a 1000-particle cube at a 5 ms step, and explicit steps blow
 /// up. Dividing k_c by N^(2/3) keeps a face's sink at 0.01 dx and omega dt near 1; the damping
 /// gives e = 0.2 for that face against a wall (reduced mass M / N^(2/3)).
+/// [D] Each fragment has its own law, and a pair of fragments takes the lighter one's
+/// (ContactLaw::pair_scale): one law for the lightest fragment let a block sink through the
+/// floor once a crack had chipped a few particles off somewhere, and the heavier one's made a
+/// crumb under a block ring so fast that the contact sub-steps stalled the run.
 ContactLaw fragment_contact_law(const Model& model, const State& state) {
-    std::vector<Index> members(state.porous.fragments.size(), 0);
+    const std::vector<Fragment>& fragments = state.porous.fragments;
+    std::vector<Index> members(fragments.size(), 0);
     for (Index f : state.porous.particles.fragment) ++members[f];
+    std::vector<Real> per_face(fragments.size(), 0);
     Real lightest = 0;
     for (size_t f = 0; f < members.size(); ++f) {
-        const Fragment& fr = state.porous.fragments[f];
-        if (fr.anchored || members[f] == 0) continue;
-        const Real per_face = fr.mass / std::pow(Real(members[f]), 2.0 / 3.0);
-        if (lightest == 0 || per_face < lightest) lightest = per_face;
+        if (fragments[f].anchored || members[f] == 0 || fragments[f].mass <= 0) continue;
+        per_face[f] = fragments[f].mass / std::pow(Real(members[f]), 2.0 / 3.0);
+        if (lightest == 0 || per_face[f] < lightest) lightest = per_face[f];
     }
     if (lightest == 0) {  // only anchored fragments: they touch but do not move
         ContactLaw none;
@@ -35,7 +40,10 @@ ContactLaw fragment_contact_law(const Model& model, const State& state) {
     }
     const Real g =
         std::max(model.scene.gravity.norm(), Real(9.81));  // weightless scenes still collide
-    return ContactLaw::for_fragments(model.dx, lightest, g, 2 * lightest);
+    ContactLaw law = ContactLaw::for_fragments(model.dx, lightest, g, 2 * lightest);
+    law.scale.resize(fragments.size());
+    for (size_t f = 0; f < fragments.size(); ++f) law.scale[f] = per_face[f] / lightest;
+    return law;
 }
 
 /// The highest contact frequency of the free fragments over the next dt, rad/s: per fragment the
@@ -62,12 +70,15 @@ Real contact_frequency(const Model& model, const State& state, const ContactLaw&
         touching[f] = 1;
     };
     for (Index k = 0; k < p.size(); ++k) {  // serial: a few pairs per touching member
-        if (!is_free(p.fragment[k])) continue;
+        const Index f = p.fragment[k];
+        if (!is_free(f)) continue;
         s.porous_porous.for_each(k, [&](Index j) {
-            if (p.fragment[j] == p.fragment[k] || p.origin[j] == p.origin[k]) return;
-            add(k, p.x[k] - p.x[j], p.v[k] - p.v[j], is_free(p.fragment[j]) ? 2 : 1);
+            if (p.fragment[j] == f || p.origin[j] == p.origin[k]) return;
+            add(k, p.x[k] - p.x[j], p.v[k] - p.v[j],
+                (is_free(p.fragment[j]) ? 2 : 1) * law.pair_scale(f, p.fragment[j]));
         });
-        s.porous_wall.for_each(k, [&](Index w) { add(k, p.x[k] - model.walls.x[w], p.v[k], 1); });
+        s.porous_wall.for_each(
+            k, [&](Index w) { add(k, p.x[k] - model.walls.x[w], p.v[k], law.pair_scale(f, f)); });
     }
     Real highest = 0;
     for (size_t f = 0; f < fragments.size(); ++f) {
@@ -124,6 +135,27 @@ void move_fragments(const Model& model, State& state, const std::vector<Vec3>& f
     });
 }
 
+/// [D] Where a free fragment meets an anchored structure: the structure's surface displaced by u
+/// up to a tenth of a spacing, at rest. A contact that followed any u fed the spring's answer to
+/// u back into the next Biot call's loads, which rang up where the contact was stiffer than the
+/// rock under it (a heavy fragment on a nearly cut-off part of a cracked body: swings of
+/// decimetres within three calls); beyond the cap the contact no longer answers u. Within it, a
+/// piece cut from the body meets the body where both were.
+std::vector<Vec3> contact_positions(const Model& model, const State& state) {
+    const PorousParticles& p = state.porous.particles;
+    const StructureState& st = state.structures;
+    std::vector<Vec3> x = p.x;
+    if (st.empty()) return x;
+    const Real cap = 0.1 * model.dx;
+    parallel_for(p.size(), [&](Index k) {
+        const Index id = p.id[k];
+        if (size_t(id) >= st.node_of.size() || st.node_of[id].first < 0) return;
+        const Vec3 u = p.x[k] - st.rest_x[id];
+        if (const Real norm = u.norm(); norm > cap) x[k] = st.rest_x[id] + (cap / norm) * u;
+    });
+    return x;
+}
+
 }  // namespace
 
 void advance_fragments(const Model& model, State& state, Real dt) {
@@ -142,10 +174,11 @@ void advance_fragments(const Model& model, State& state, Real dt) {
             omega > 0 ? std::max(1, int(std::ceil(dt / contact_sub_step(omega, law) - 1e-9))) : 1;
         const Real h = dt / substeps;
         const std::vector<Vec3> fluid = s.force;
+        const std::vector<Vec3> still_x = contact_positions(model, state);
         std::vector<Vec3> force(p.size()), mean(p.size(), Vec3::Zero());
         for (int sub = 0; sub < substeps; ++sub) {
             force = fluid;
-            Index touching = add_contact_forces(p, s.porous_porous, law, force);
+            Index touching = add_contact_forces(p, s.porous_porous, law, force, still_x);
             touching += add_wall_contact_forces(p, s.porous_wall, model.walls.x, law, force);
             if (sub == 0) s.contacts = touching;
             move_fragments(model, state, force, h);
