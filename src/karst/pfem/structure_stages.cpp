@@ -3,7 +3,6 @@
 #include "karst/core/parallel.hpp"
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/face_links.hpp"
-#include "karst/pfem/p1_tet.hpp"
 #include "karst/scene/wall_crossing.hpp"
 
 #include <algorithm>
@@ -59,23 +58,6 @@ BiotFields fields_with_weight(const StructureState& st, const Structure& s) {
     BiotFields fields = s.fields;
     for (size_t a = 0; a < fields.u.size(); ++a) fields.u[a] += st.weight_u[s.node_id[a]];
     return fields;
-}
-
-Real elastic_energy(const Model& model, const State& state) {
-    const StructureState& st = state.structures;
-    Real total = 0;
-    for (const Structure& s : st.structures) {
-        const BiotMaterial m = biot_material(model, model.scene.porous_solids[s.solid].material);
-        const Real lambda = m.lame_lambda(), mu = m.shear_modulus();
-        const BiotFields f = fields_with_weight(st, s);
-        for (Index e = 0; e < s.mesh.tet_count(); ++e) {
-            const P1Tet p = p1_tet(s.mesh, e);
-            const Mat3 eps = p1_strain(p, s.mesh.tets[e], f.u);
-            total += 0.5 * std::abs(p.volume) *
-                     (lambda * eps.trace() * eps.trace() + 2 * mu * eps.squaredNorm());
-        }
-    }
-    return total;
 }
 
 BiotSolver& solver_of(const Model& model, State& state, size_t slot) {

@@ -22,11 +22,6 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot);
 /// the solid carries.
 BiotFields fields_with_weight(const StructureState& st, const Structure& s);
 
-/// The elastic strain energy of the structures' skeletons, sum over tets of 1/2 V eps : C : eps
-/// with the strain of u plus the rest state's (fields_with_weight), J: what a crack can turn
-/// into motion.
-Real elastic_energy(const Model& model, const State& state);
-
 /// Meshes every anchored fragment of a permeable solid on its particles' rest positions and
 /// builds its Biot problem (t = 0).
 void build_structures(const Model& model, State& state);

@@ -107,7 +107,7 @@ void fields(Ar& ar, SupportLog& l) {
 template <class Ar>
 void fields(Ar& ar, FrameLog& l) {
     ar(l.time, l.dt, l.steps, l.particles, l.density_error, l.mipps, l.kinetic_energy,
-       l.potential_energy, l.elastic_energy, l.removed, l.speed_p99, l.max_speed, l.supports);
+       l.potential_energy, l.removed, l.speed_p99, l.max_speed, l.supports);
 }
 
 template <class Ar>

@@ -1,8 +1,7 @@
 #pragma once
 // The mechanical energy account (issue 11): kinetic and potential energy of the fluid and the
-// porous particles (which carry their fragments' mass: grains and pore water), and the elastic
-// energy of the meshed solids. A closed system may lose energy to viscosity, inelastic impacts
-// and cracks, never gain it; the account says when it did.
+// porous particles (which carry their fragments' mass: grains and pore water). A closed system
+// may lose energy to viscosity and inelastic impacts, never gain it; the account says when it did.
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 
@@ -11,22 +10,19 @@ namespace karst {
 struct Energy {
     Real kinetic = 0;    ///< sum 1/2 m |v|^2, J
     Real potential = 0;  ///< sum -m g.x (zero at the origin), J
-    Real elastic = 0;    ///< strain energy of the structures (pfem/structure_stages.hpp), J
-    Real total() const { return kinetic + potential + elastic; }
+    Real total() const { return kinetic + potential; }
 };
 
 /// Kinetic and potential energy of the fluid (true mass m) and the porous particles
-/// (grains + pore water, moving with their fragment's rigid velocity), and the structures'
-/// elastic energy: a crack that lets a loaded piece go turns it into motion. Thread-count
-/// independent.
+/// (grains + pore water, moving with their fragment's rigid velocity). Thread-count independent.
 Energy mechanical_energy(const Model& model, const State& state);
 
 /// The 99th percentile and the maximum of the fluid particles' speeds, m/s.
 std::pair<Real, Real> fluid_speed_p99_and_max(const FluidParticles& fluid);
 
 /// Follows the energy frame by frame. `released` is what the motion has had to spend: the
-/// initial kinetic energy plus the largest drop of potential and elastic energy so far. A rise of
-/// the total over its lowest value so far is energy the numerics made.
+/// initial kinetic energy plus the largest drop of potential energy so far. A rise of the total
+/// over its lowest value so far is energy the numerics made.
 class EnergyAccount {
 public:
     EnergyAccount() = default;
@@ -44,8 +40,8 @@ public:
     /// The account's fields for a checkpoint (io/binary_archive.hpp).
     template <class Archive>
     friend void fields(Archive& ar, EnergyAccount& a) {
-        ar(a.m_start.kinetic, a.m_start.potential, a.m_start.elastic, a.m_lowest, a.m_released,
-           a.m_largest_gain, a.m_largest_rise, a.m_worst_ratio);
+        ar(a.m_start.kinetic, a.m_start.potential, a.m_lowest, a.m_released, a.m_largest_gain,
+           a.m_largest_rise, a.m_worst_ratio);
     }
 
 private:

@@ -239,8 +239,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         out->write_boundary(model.walls);
         out->folder().write("render.json",
                             render_settings_json(scene.render, pictured_walls(scene)));
-        // The energy account (issue 11): a rise of kinetic + potential + elastic energy over 5 % of
-        // the energy released so far is energy the numerics made; the run says so once.
+        // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the
+        // energy released so far is energy the numerics made; the run says so once.
         record.energy = EnergyAccount(mechanical_energy(model, state));
     }
     std::optional<LiveRenderer> live;
@@ -259,17 +259,16 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
         log.kinetic_energy = e.kinetic, log.potential_energy = e.potential,
-        log.elastic_energy = e.elastic, log.removed = state.removed;
+        log.removed = state.removed;
         std::tie(log.speed_p99, log.max_speed) = fluid_speed_p99_and_max(state.fluid);
         record.energy.add(e);
         if (!record.energy_warned && record.energy.gained_more_than(0.05)) {
             record.energy_warned = true;
-            progress.warn(
-                fmt::format("t = {:.4g} s: the kinetic + potential + elastic energy rose by {:.3g} "
-                            "J, {:.0f} % of the "
-                            "{:.3g} J released so far (log.csv has the account)",
-                            state.time, record.energy.largest_gain(),
-                            100 * record.energy.worst_ratio(), record.energy.released()));
+            progress.warn(fmt::format(
+                "t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the "
+                "{:.3g} J released so far (log.csv has the account)",
+                state.time, record.energy.largest_gain(), 100 * record.energy.worst_ratio(),
+                record.energy.released()));
         }
         if (!record.removed_warned && state.removed > 0) {
             record.removed_warned = true;
