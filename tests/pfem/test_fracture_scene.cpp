@@ -46,15 +46,12 @@ Real total_mechanical_energy(const test::Simulation& sim) {
 
 struct Totals {
     Real mass = 0, water = 0;
-    Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
 };
 
 Totals totals(const PorousParticles& p) {
     Totals t;
     for (Index i = 0; i < p.size(); ++i) {
-        const Real m = p.solid_mass[i] + p.absorbed_mass[i];
-        t.mass += m, t.water += p.absorbed_mass[i];
-        t.momentum += m * p.v[i], t.angular += m * p.x[i].cross(p.v[i]);
+        t.mass += p.solid_mass[i] + p.absorbed_mass[i], t.water += p.absorbed_mass[i];
     }
     return t;
 }
