@@ -435,5 +435,35 @@ TEST(FractureScene, TheShippedCollapsingSceneBreaksIntoFragmentsWithoutGainingEn
     EXPECT_LT(highest, e0 * 1.001) << "kinetic + potential energy rose";
 }
 
+// Fig. 9 at its size: the water poured on the block soaks its foot from the pool, the soaked
+// side spalls into about a dozen saturated pieces, and nothing gains energy.
+TEST(FractureScene, TheShippedSoakedBlockSpallsItsSoakedSideIntoAboutADozenPieces) {
+    test::Simulation sim(
+        test::read_text(std::string(KARST_SOURCE_DIR) + "/scenes/soaked_block.json"));
+    const Real water0 = totals(sim.state.porous.particles).water;
+    const Real e0 = total_mechanical_energy(sim);
+    Real highest = e0;
+    sim.run_until(sim.model.scene.time.end - 1e-9,
+                  [&] { highest = std::max(highest, total_mechanical_energy(sim)); });
+    EXPECT_LT(highest, e0 * 1.001) << "kinetic + potential energy rose";
+    const PorousParticles& p = sim.state.porous.particles;
+    EXPECT_GT(totals(p).water - water0, 5.0) << "kg soaked in";
+    const PoreWaterLaw& law = sim.model.pore_laws[0];
+    const auto& fragments = sim.state.porous.fragments;
+    std::vector<Real> saturation(fragments.size(), 0), members(fragments.size(), 0);
+    for (Index i = 0; i < p.size(); ++i) {
+        saturation[p.fragment[i]] += law.saturation(p.absorbed_mass[i], p.porosity[i], p.volume[i]);
+        ++members[p.fragment[i]];
+    }
+    Index pieces = 0;
+    for (size_t f = 0; f < fragments.size(); ++f) {
+        if (fragments[f].anchored || members[f] == 0) continue;
+        ++pieces;
+        EXPECT_GT(saturation[f] / members[f], 0.95) << "fragment " << f << " is not soaked";
+    }
+    EXPECT_GE(pieces, 6);
+    EXPECT_LE(pieces, 24);
+}
+
 }  // namespace
 }  // namespace karst

@@ -149,7 +149,7 @@ TEST(SceneFormat, GeneratedDocsAreCommitted) {
 TEST(SceneFormat, ShippedScenesAreValid) {
     for (const char* name :
          {"dam_break_obstacle.json", "martin_moyce_dam_break.json", "bench_dam_break_118k.json",
-          "collapsing.json", "hydraulic_fracture.json"}) {
+          "collapsing.json", "hydraulic_fracture.json", "soaked_block.json"}) {
         const std::string path = std::string(KARST_SOURCE_DIR) + "/scenes/" + name;
         EXPECT_NO_THROW(load_scene_file(path)) << path;
     }
