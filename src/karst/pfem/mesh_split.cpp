@@ -90,6 +90,33 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
             if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
                 slots.join(slot_of(a, l.a), slot_of(a, l.b));
 
+    // The cut faces at each node, area-weighted, pointing into the tet on each side: a copy moves
+    // away from the faces that cut its group off, along the crack (a move towards its group's
+    // centroid tilts into the body at a surface node and brought copies across a crack closer).
+    std::vector<Vec3> away_from_cut(start[n], Vec3::Zero());
+    const auto centroid = [&](Index e) {
+        const Tet& t = mesh.tets[e];
+        return Vec3(0.25 *
+                    (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]));
+    };
+    for (size_t k = 0; k < links.size(); ++k) {
+        if (!broken[k]) continue;
+        const ElementLink& l = links[k];
+        std::array<Index, 3> face{};
+        int found = 0;
+        for (Index a : mesh.tets[l.a])
+            if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
+                if (found < 3) face[found++] = a;
+        if (found != 3) continue;
+        Vec3 normal = 0.5 * (mesh.nodes[face[1]] - mesh.nodes[face[0]])
+                                .cross(mesh.nodes[face[2]] - mesh.nodes[face[0]]);
+        if (normal.dot(centroid(l.b) - centroid(l.a)) < 0) normal = -normal;
+        for (Index a : face) {
+            away_from_cut[slot_of(a, l.a)] -= normal;
+            away_from_cut[slot_of(a, l.b)] += normal;
+        }
+    }
+
     out.mesh = mesh;
     out.source.resize(n);
     std::iota(out.source.begin(), out.source.end(), 0);
@@ -103,7 +130,7 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
         if (roots.size() < 2) continue;
         ++out.split_nodes;
         std::vector<Real> volume(roots.size(), 0);
-        std::vector<Vec3> side(roots.size(), Vec3::Zero());
+        std::vector<Vec3> side(roots.size(), Vec3::Zero()), cut(roots.size(), Vec3::Zero());
         std::vector<Index> copy(roots.size());
         for (size_t g = 0; g < roots.size(); ++g) {
             copy[g] = g == 0 ? a : Index(out.source.size());
@@ -118,6 +145,7 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
             const Real v = mesh.tet_volume(e) / 4;
             const Tet& t = mesh.tets[e];
             volume[g] += v;
+            cut[g] += away_from_cut[s];
             side[g] += v * (0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] +
                                     mesh.nodes[t[3]]) -
                             mesh.nodes[a]);
@@ -133,7 +161,8 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
         moves.assign(roots.size(), Vec3::Zero());
         for (size_t g = 0; g < roots.size(); ++g) {
             out.share[copy[g]] = volume[g] / total;
-            if (side[g].norm() > 0) moves[g] = offset * side[g].normalized();
+            const Vec3& towards = cut[g].norm() > 0 ? cut[g] : side[g];
+            if (towards.norm() > 0) moves[g] = offset * towards.normalized();
             mean += out.share[copy[g]] * moves[g];
         }
         // Shorter moves where the full ones would flatten a tet around the node to under half

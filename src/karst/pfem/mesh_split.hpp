@@ -21,7 +21,8 @@ struct MeshSplit {
 
 /// M27: around every node, its tets are grouped by the unbroken links among them; a node with k
 /// groups becomes k nodes, one per group, sharing the node by the groups' volumes
-/// (sum V_e / 4). Each copy moves `offset` towards its group's side, and the moves are shifted
+/// (sum V_e / 4). Each copy moves `offset` away from the broken faces that cut its group off
+/// (along the crack's normal; towards its group's centroid if none), and the moves are shifted
 /// so that their share-weighted sum is zero: mass-weighted positions, hence the linear and
 /// angular momentum of copies given the source's velocity, are kept.
 MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
