@@ -1,5 +1,6 @@
 #include "karst/pfem/cracks.hpp"
 
+#include "karst/pfem/face_links.hpp"
 #include "karst/pfem/p1_tet.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -12,20 +13,12 @@ namespace karst {
 
 namespace {
 
-Vec3 centroid(const TetMesh& mesh, Index e) {
-    const Tet& t = mesh.tets[e];
-    return 0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]);
-}
-
 /// Centroid of the face two linked tets share: the mean of the nodes they have in common.
 Vec3 shared_face_centroid(const TetMesh& mesh, const ElementLink& link) {
-    const Tet& a = mesh.tets[link.a];
-    const Tet& b = mesh.tets[link.b];
+    const SharedNodes shared = shared_nodes(mesh, link);
     Vec3 sum = Vec3::Zero();
-    int count = 0;
-    for (Index n : a)
-        if (std::find(b.begin(), b.end(), n) != b.end()) sum += mesh.nodes[n], ++count;
-    return sum / std::max(count, 1);
+    for (Index n : shared) sum += mesh.nodes[n];
+    return sum / std::max(shared.count, 1);
 }
 
 }  // namespace
@@ -130,7 +123,7 @@ std::vector<LinkGeometry> link_geometry(const TetMesh& mesh, std::span<const Ele
     std::vector<LinkGeometry> geometry(links.size());
     for (size_t k = 0; k < links.size(); ++k) {
         LinkGeometry& g = geometry[k];
-        g.a = centroid(mesh, links[k].a), g.b = centroid(mesh, links[k].b);
+        g.a = mesh.tet_centroid(links[k].a), g.b = mesh.tet_centroid(links[k].b);
         g.face = shared_face_centroid(mesh, links[k]);
         g.reach2 = std::max((g.a - g.face).squaredNorm(), (g.b - g.face).squaredNorm());
     }

@@ -2,6 +2,7 @@
 
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/cracks.hpp"
+#include "karst/pfem/face_links.hpp"
 #include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/rigid_modes.hpp"
 #include "karst/pfem/structure_stages.hpp"
@@ -25,15 +26,6 @@ constexpr Real k_split_offset = 0.05;
 /// Single tets chipped off by crossing crack disks became fragments of four particles that the
 /// fluid blew out of the scene.
 constexpr Index k_min_piece_tets = 24;
-
-/// The shared face's nodes of a link.
-std::vector<Index> shared_nodes(const TetMesh& mesh, const ElementLink& l) {
-    std::vector<Index> nodes;
-    for (Index a : mesh.tets[l.a])
-        if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
-            nodes.push_back(a);
-    return nodes;
-}
 
 /// Appends a copy of particle i with id `id` (all attributes, then the id).
 void append_copy(PorousParticles& p, Index i, Index id) {

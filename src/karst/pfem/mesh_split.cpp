@@ -1,6 +1,7 @@
 #include "karst/pfem/mesh_split.hpp"
 
 #include "karst/core/disjoint_sets.hpp"
+#include "karst/pfem/face_links.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -86,31 +87,21 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
                      around.begin());
     };
     for (const ElementLink& l : out.links)
-        for (Index a : mesh.tets[l.a])
-            if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
-                slots.join(slot_of(a, l.a), slot_of(a, l.b));
+        for (Index a : shared_nodes(mesh, l)) slots.join(slot_of(a, l.a), slot_of(a, l.b));
 
     // The cut faces at each node, area-weighted, pointing into the tet on each side: a copy moves
     // away from the faces that cut its group off, along the crack (a move towards its group's
     // centroid tilts into the body at a surface node and brought copies across a crack closer).
     std::vector<Vec3> away_from_cut(start[n], Vec3::Zero());
-    const auto centroid = [&](Index e) {
-        const Tet& t = mesh.tets[e];
-        return Vec3(0.25 *
-                    (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] + mesh.nodes[t[3]]));
-    };
     for (size_t k = 0; k < links.size(); ++k) {
         if (!broken[k]) continue;
         const ElementLink& l = links[k];
-        std::array<Index, 3> face{};
-        int found = 0;
-        for (Index a : mesh.tets[l.a])
-            if (std::find(mesh.tets[l.b].begin(), mesh.tets[l.b].end(), a) != mesh.tets[l.b].end())
-                if (found < 3) face[found++] = a;
-        if (found != 3) continue;
-        Vec3 normal = 0.5 * (mesh.nodes[face[1]] - mesh.nodes[face[0]])
-                                .cross(mesh.nodes[face[2]] - mesh.nodes[face[0]]);
-        if (normal.dot(centroid(l.b) - centroid(l.a)) < 0) normal = -normal;
+        const SharedNodes face = shared_nodes(mesh, l);
+        if (face.count != 3) continue;
+        const std::array<Index, 3>& f = face.node;
+        Vec3 normal =
+            0.5 * (mesh.nodes[f[1]] - mesh.nodes[f[0]]).cross(mesh.nodes[f[2]] - mesh.nodes[f[0]]);
+        if (normal.dot(mesh.tet_centroid(l.b) - mesh.tet_centroid(l.a)) < 0) normal = -normal;
         for (Index a : face) {
             away_from_cut[slot_of(a, l.a)] -= normal;
             away_from_cut[slot_of(a, l.b)] += normal;
@@ -143,12 +134,9 @@ MeshSplit split_mesh(const TetMesh& mesh, std::span<const ElementLink> links,
             const size_t g = std::find(roots.begin(), roots.end(), slots.find(s)) - roots.begin();
             const Index e = around[s];
             const Real v = mesh.tet_volume(e) / 4;
-            const Tet& t = mesh.tets[e];
             volume[g] += v;
             cut[g] += away_from_cut[s];
-            side[g] += v * (0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] +
-                                    mesh.nodes[t[3]]) -
-                            mesh.nodes[a]);
+            side[g] += v * (mesh.tet_centroid(e) - mesh.nodes[a]);
             for (Index& node : out.mesh.tets[e])
                 if (node == a) node = copy[g];
         }

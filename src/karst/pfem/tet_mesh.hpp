@@ -44,6 +44,10 @@ struct TetMesh {
     Index node_count() const { return Index(nodes.size()); }
     Index tet_count() const { return Index(tets.size()); }
     Real tet_volume(Index e) const;
+    Vec3 tet_centroid(Index e) const {
+        const Tet& t = tets[e];
+        return 0.25 * (nodes[t[0]] + nodes[t[1]] + nodes[t[2]] + nodes[t[3]]);
+    }
     /// Area-weighted outward normal of a boundary triangle (length = area).
     Vec3 area_vector(const Triangle& t) const;
 };
