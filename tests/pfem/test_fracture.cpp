@@ -277,17 +277,80 @@ TEST(MeshSplit, SmallPiecesAreSparedUnlessTheyStayAnchored) {
     EXPECT_EQ(cut[4], 0);
 }
 
+/// A bar 1 x 0.3 x 0.3 m on the lattice, its links, and those a crack disk at x = 0.5 with
+/// normal x, centred at (y, z), cuts.
+struct CutBar {
+    TetMesh mesh;
+    std::vector<ElementLink> links;
+    std::vector<Index> cutter;
+
+    CutBar(Real y, Real z, Real radius) {
+        const std::vector<Vec3> nodes = box_lattice_nodes(Vec3::Zero(), Vec3(1, 0.3, 0.3), k_dx);
+        mesh = build_tet_mesh(nodes, std::vector<Real>(nodes.size(), k_dx), MeshOptions{});
+        links = face_links(mesh);
+        Crack c;
+        c.centre = Vec3(0.5, y, z), c.normal = Vec3::UnitX(), c.radius = radius;
+        cutter = links_cut(mesh, links, std::span(&c, 1));
+    }
+};
+
+TEST(MeshSplit, ARemeshOfACrackedBarKeepsTheCrackOpen) {
+    // A crack through the half of the section at y < 0.15: the bar stays one piece.
+    const CutBar bar(0, 0.15, 0.16);
+    const TetMesh& mesh = bar.mesh;
+    const std::vector<ElementLink>& links = bar.links;
+    const std::vector<Index>& cutter = bar.cutter;
+    std::vector<char> broken(links.size());
+    std::vector<char> source_on_crack(mesh.node_count(), 0);
+    for (size_t k = 0; k < links.size(); ++k)
+        if ((broken[k] = cutter[k] >= 0))
+            for (Index a : shared_nodes(mesh, links[k])) source_on_crack[a] = 1;
+    const MeshSplit split = split_mesh(mesh, links, broken, 0.05 * k_dx);
+    ASSERT_EQ(split.components, 1);
+    ASSERT_GT(split.split_nodes, 0);
+    // The particles sit where the split moved them; a fresh triangulation of them fills the gap.
+    const Index n = split.mesh.node_count();
+    TetMesh fresh =
+        build_tet_mesh(split.mesh.nodes, std::vector<Real>(size_t(n), k_dx), MeshOptions{});
+    ASSERT_EQ(fresh.node_count(), n);
+    const auto closing = [](const TetMesh& m) {  // tets across the cut half of the plane
+        Index count = 0;
+        for (Index e = 0; e < m.tet_count(); ++e) {
+            bool left = false, right = false;
+            for (Index a : m.tets[e]) {
+                const Real x = m.nodes[a].x();
+                left = left || x < 0.499;
+                right = right || x > 0.501;
+            }
+            count += left && right && m.tet_centroid(e).y() < 0.1;
+        }
+        return count;
+    };
+    ASSERT_GT(closing(fresh), 0);
+    std::vector<Index> old_node(static_cast<size_t>(n));
+    std::iota(old_node.begin(), old_node.end(), Index(0));
+    std::vector<char> on_crack(static_cast<size_t>(n));
+    for (Index k = 0; k < n; ++k) on_crack[k] = source_on_crack[split.source[k]];
+    const Index before = fresh.tet_count();
+    const Index removed =
+        drop_tets_across_cracks(fresh, split.mesh, split.links, old_node, on_crack);
+    EXPECT_EQ(closing(fresh), 0);
+    EXPECT_EQ(fresh.tet_count(), before - removed);
+    // Only the gap's tets go: the rest of the bar is meshed as before, and it is still one piece.
+    EXPECT_GE(fresh.tet_count(), split.mesh.tet_count() - 12);
+    EXPECT_LE(fresh.tet_count(), split.mesh.tet_count() + 12);
+    const std::vector<ElementLink> fresh_links = face_links(fresh);
+    EXPECT_EQ(
+        split_mesh(fresh, fresh_links, std::vector<char>(fresh_links.size(), 0), 0).components, 1);
+}
+
 TEST(MeshSplit, ACutThroughABarSplitsItsNodesAndSharesTheirVolume) {
-    const Vec3 size(1.0, 0.3, 0.3);
-    std::vector<Vec3> nodes = box_lattice_nodes(Vec3::Zero(), size, k_dx);
-    const TetMesh mesh =
-        build_tet_mesh(nodes, std::vector<Real>(nodes.size(), k_dx), MeshOptions{});
-    const std::vector<ElementLink> links = face_links(mesh);
     // A crack disk at x = 0.5 across the whole section (the plane runs through a lattice layer:
     // every tet lies on one side of it).
-    Crack c;
-    c.centre = Vec3(0.5, 0.15, 0.15), c.normal = Vec3::UnitX(), c.radius = 0.5;
-    const std::vector<Index> cutter = links_cut(mesh, links, std::span(&c, 1));
+    const CutBar bar(0.15, 0.15, 0.5);
+    const TetMesh& mesh = bar.mesh;
+    const std::vector<ElementLink>& links = bar.links;
+    const std::vector<Index>& cutter = bar.cutter;
     std::vector<char> broken(links.size());
     for (size_t k = 0; k < links.size(); ++k) broken[k] = cutter[k] >= 0;
     const MeshSplit split = split_mesh(mesh, links, broken, 0.05 * k_dx);

@@ -274,4 +274,49 @@ TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loos
     return out;
 }
 
+Index drop_tets_across_cracks(TetMesh& mesh, const TetMesh& old_mesh,
+                              std::span<const ElementLink> old_links,
+                              std::span<const Index> old_node, std::span<const char> on_crack) {
+    // Per old node: the tets it belongs to, and those with the tets linked to them.
+    std::vector<std::vector<Index>> own(old_mesh.node_count()), near(old_mesh.node_count());
+    for (Index e = 0; e < old_mesh.tet_count(); ++e)
+        for (Index a : old_mesh.tets[e]) own[a].push_back(e), near[a].push_back(e);
+    for (const ElementLink& l : old_links) {
+        for (Index a : old_mesh.tets[l.a]) near[a].push_back(l.b);
+        for (Index a : old_mesh.tets[l.b]) near[a].push_back(l.a);
+    }
+    for (std::vector<Index>& n : near) {
+        std::sort(n.begin(), n.end());
+        n.erase(std::unique(n.begin(), n.end()), n.end());
+    }
+    // Two crack nodes are on one side when a tet of one is, or is linked to, a tet of the other.
+    const auto across = [&](Index a, Index b) {
+        if (!on_crack[a] || !on_crack[b]) return false;
+        const Index oa = old_node[a], ob = old_node[b];
+        if (oa < 0 || ob < 0) return false;
+        for (Index e : own[ob])
+            if (std::binary_search(near[oa].begin(), near[oa].end(), e)) return false;
+        return true;
+    };
+    std::vector<Tet> kept;
+    std::vector<Index> kept_polyhedron;
+    for (Index e = 0; e < mesh.tet_count(); ++e) {
+        const Tet& t = mesh.tets[e];
+        bool closes = false;
+        for (int i = 0; i < 4 && !closes; ++i)
+            for (int k = i + 1; k < 4 && !closes; ++k) closes = across(t[i], t[k]);
+        if (closes) continue;
+        kept.push_back(t);
+        if (!mesh.tet_polyhedron.empty()) kept_polyhedron.push_back(mesh.tet_polyhedron[e]);
+    }
+    const Index removed = mesh.tet_count() - Index(kept.size());
+    if (removed == 0) return 0;
+    mesh.tets = std::move(kept);
+    if (!mesh.tet_polyhedron.empty()) mesh.tet_polyhedron = std::move(kept_polyhedron);
+    compact_ids(mesh.tet_polyhedron);
+    mesh.boundary = boundary_faces(mesh.tets);
+    mesh.quality.elements = mesh.tet_count();
+    return removed;
+}
+
 }  // namespace karst

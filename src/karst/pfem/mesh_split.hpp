@@ -55,6 +55,17 @@ Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
 TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loose_nodes,
                  std::vector<Index>& node_of, std::vector<Index>& tet_of);
 
+/// §5.6: a remesh keeps the cracks. Removes from `mesh` (a new triangulation of a cracked
+/// body's particles) every tet with two nodes that both lie on broken faces (`on_crack`) and that
+/// the mesh it replaces kept apart (no tet of one is, or is linked by `old_links` to, a tet of the
+/// other): the two sides of a crack, whose split copies sit a tenth of a spacing apart, and
+/// which a Delaunay closes with flat tets. `old_node[a]` is node a's index in `old_mesh`, or -1
+/// for a node new to the body (it may join anything). Nodes are kept, the tets keep their order.
+/// Returns the tets removed.
+Index drop_tets_across_cracks(TetMesh& mesh, const TetMesh& old_mesh,
+                              std::span<const ElementLink> old_links,
+                              std::span<const Index> old_node, std::span<const char> on_crack);
+
 /// The faces that belong to one tet only, oriented outward.
 std::vector<Triangle> boundary_faces(std::span<const Tet> tets);
 

@@ -3,6 +3,7 @@
 #include "karst/core/parallel.hpp"
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/face_links.hpp"
+#include "karst/pfem/mesh_split.hpp"
 #include "karst/scene/wall_crossing.hpp"
 
 #include <algorithm>
@@ -122,7 +123,18 @@ void build(const Model& model, State& state, size_t slot, bool new_rest_state) {
     });
     std::vector<Vec3> x;
     for (Index id : s.node_id) x.push_back(st.rest_x[id]);
+    // A remesh of a cracked body keeps its cracks: the old mesh says which nodes were apart.
+    std::vector<Index> old_node(s.node_id.size(), -1);
+    std::vector<char> on_crack(s.node_id.size(), 0);
+    for (size_t a = 0; a < s.node_id.size(); ++a) {
+        const Index id = s.node_id[a];
+        if (st.node_of[id].first == Index(slot)) old_node[a] = st.node_of[id].second;
+        on_crack[a] = st.damage[id] > 0;
+    }
+    const TetMesh old_mesh = std::move(s.mesh);
+    const std::vector<ElementLink> old_links = std::move(s.links);
     s.mesh = mesh_points(model, x, st.timings);
+    drop_tets_across_cracks(s.mesh, old_mesh, old_links, old_node, on_crack);
     s.mesh_version = st.next_mesh_version++;
     s.mobility_scale.clear(), s.flow_time_step = -1;  // a new mesh's solver starts afresh
     s.split_of_version = -1, s.split_source.clear();
