@@ -282,7 +282,7 @@ TEST(MeshSplit, SmallPiecesAreSparedUnlessTheyStayAnchored) {
 struct CutBar {
     TetMesh mesh;
     std::vector<ElementLink> links;
-    std::vector<Index> cutter;
+    std::vector<char> broken;
 
     CutBar(Real y, Real z, Real radius) {
         const std::vector<Vec3> nodes = box_lattice_nodes(Vec3::Zero(), Vec3(1, 0.3, 0.3), k_dx);
@@ -290,22 +290,19 @@ struct CutBar {
         links = face_links(mesh);
         Crack c;
         c.centre = Vec3(0.5, y, z), c.normal = Vec3::UnitX(), c.radius = radius;
-        cutter = links_cut(mesh, links, std::span(&c, 1));
+        const std::vector<Index> cutter = links_cut(mesh, links, std::span(&c, 1));
+        for (Index k : cutter) broken.push_back(k >= 0);
     }
 };
 
 TEST(MeshSplit, ARemeshOfACrackedBarKeepsTheCrackOpen) {
     // A crack through the half of the section at y < 0.15: the bar stays one piece.
     const CutBar bar(0, 0.15, 0.16);
-    const TetMesh& mesh = bar.mesh;
-    const std::vector<ElementLink>& links = bar.links;
-    const std::vector<Index>& cutter = bar.cutter;
-    std::vector<char> broken(links.size());
-    std::vector<char> source_on_crack(mesh.node_count(), 0);
-    for (size_t k = 0; k < links.size(); ++k)
-        if ((broken[k] = cutter[k] >= 0))
-            for (Index a : shared_nodes(mesh, links[k])) source_on_crack[a] = 1;
-    const MeshSplit split = split_mesh(mesh, links, broken, 0.05 * k_dx);
+    std::vector<char> source_on_crack(bar.mesh.node_count(), 0);
+    for (size_t k = 0; k < bar.links.size(); ++k)
+        if (bar.broken[k])
+            for (Index a : shared_nodes(bar.mesh, bar.links[k])) source_on_crack[a] = 1;
+    const MeshSplit split = split_mesh(bar.mesh, bar.links, bar.broken, 0.05 * k_dx);
     ASSERT_EQ(split.components, 1);
     ASSERT_GT(split.split_nodes, 0);
     // The particles sit where the split moved them; a fresh triangulation of them fills the gap.
@@ -326,22 +323,22 @@ TEST(MeshSplit, ARemeshOfACrackedBarKeepsTheCrackOpen) {
         }
         return count;
     };
-    ASSERT_GT(closing(fresh), 0);
+    const Index closing_before = closing(fresh);
+    ASSERT_GT(closing_before, 0);
     std::vector<Index> old_node(static_cast<size_t>(n));
     std::iota(old_node.begin(), old_node.end(), Index(0));
     std::vector<char> on_crack(static_cast<size_t>(n));
     for (Index k = 0; k < n; ++k) on_crack[k] = source_on_crack[split.source[k]];
-    const Index before = fresh.tet_count();
     const Index removed =
         drop_tets_across_cracks(fresh, split.mesh, split.links, old_node, on_crack);
     EXPECT_EQ(closing(fresh), 0);
-    EXPECT_EQ(fresh.tet_count(), before - removed);
+    EXPECT_GE(removed, closing_before);
     // Only the gap's tets go: the rest of the bar is meshed as before, and it is still one piece.
     EXPECT_GE(fresh.tet_count(), split.mesh.tet_count() - 12);
     EXPECT_LE(fresh.tet_count(), split.mesh.tet_count() + 12);
-    const std::vector<ElementLink> fresh_links = face_links(fresh);
-    EXPECT_EQ(
-        split_mesh(fresh, fresh_links, std::vector<char>(fresh_links.size(), 0), 0).components, 1);
+    Index pieces = 0;
+    tet_components(fresh.tet_count(), face_links(fresh), pieces);
+    EXPECT_EQ(pieces, 1);
 }
 
 TEST(MeshSplit, ACutThroughABarSplitsItsNodesAndSharesTheirVolume) {
@@ -350,9 +347,7 @@ TEST(MeshSplit, ACutThroughABarSplitsItsNodesAndSharesTheirVolume) {
     const CutBar bar(0.15, 0.15, 0.5);
     const TetMesh& mesh = bar.mesh;
     const std::vector<ElementLink>& links = bar.links;
-    const std::vector<Index>& cutter = bar.cutter;
-    std::vector<char> broken(links.size());
-    for (size_t k = 0; k < links.size(); ++k) broken[k] = cutter[k] >= 0;
+    const std::vector<char>& broken = bar.broken;
     const MeshSplit split = split_mesh(mesh, links, broken, 0.05 * k_dx);
     EXPECT_EQ(split.components, 2);
     EXPECT_EQ(split.split_nodes, 4 * 4);  // the 4 x 4 nodes of the layer x = 0.5

@@ -277,6 +277,7 @@ TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loos
 Index drop_tets_across_cracks(TetMesh& mesh, const TetMesh& old_mesh,
                               std::span<const ElementLink> old_links,
                               std::span<const Index> old_node, std::span<const char> on_crack) {
+    if (std::find(on_crack.begin(), on_crack.end(), 1) == on_crack.end()) return 0;
     // Per old node: the tets it belongs to, and those with the tets linked to them.
     std::vector<std::vector<Index>> own(old_mesh.node_count()), near(old_mesh.node_count());
     for (Index e = 0; e < old_mesh.tet_count(); ++e)
