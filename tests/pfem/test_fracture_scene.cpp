@@ -7,6 +7,7 @@
 #include "karst/core/parallel.hpp"
 #include "karst/core/soa.hpp"
 #include "karst/pfem/fracture_stage.hpp"
+#include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/structure_stages.hpp"
 #include "karst/sim/energy.hpp"
 
@@ -23,12 +24,16 @@ namespace karst {
 namespace {
 
 /// A wet bar held at one end and pulled at the other at three times its strength: one call
-/// cracks it into pieces. G_c is small, so each crack spans the section.
-std::string pulled_bar(bool fracture) {
+/// cracks it into pieces. G_c is small, so each crack spans the section. `beside` adds a shape to
+/// the bar's (a union), a JSON shape object.
+std::string pulled_bar(bool fracture, const std::string& beside = "") {
+    const std::string bar = R"({ "type": "box", "min": [0, 0, 0], "max": [1.0, 0.2, 0.2] })";
+    const std::string shape =
+        beside.empty() ? bar : R"({ "type": "union", "shapes": [)" + bar + ", " + beside + "] }";
     return fmt::format(R"({{
       "name": "pulled_bar", "particle_spacing": 0.05, "gravity": [0, 0, 0],
       "poroelastic": {{ "time_step": 0.05 }}, "fracture": {{ "enabled": {} }},
-      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [1.0, 0.2, 0.2] }},
+      "porous_solids": [ {{ "shape": {},
         "material": {{ "porosity": 0.3, "permeability": 1e-10, "youngs_modulus": 1e6, "initial_saturation": 0.7,
                         "tensile_strength": 1e5, "fracture_energy": 1e-3 }},
         "constraints": [
@@ -36,7 +41,7 @@ std::string pulled_bar(bool fracture) {
           {{ "kind": "fixed", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] }} }},
           {{ "kind": "traction", "traction": [3e5, 0, 0], "region": {{ "type": "box", "min": [1, -1, -1], "max": [2, 2, 2] }} }} ] }} ]
     }})",
-                       fracture);
+                       fracture, shape);
 }
 
 Real total_mechanical_energy(const test::Simulation& sim) {
@@ -112,6 +117,35 @@ std::vector<CrackRecord> sorted_cracks(std::vector<CrackRecord> c) {
                                             b.centre.end());
     });
     return c;
+}
+
+TEST(FractureScene, APieceUnderTheResolutionThatNoCrackCutOffStaysInTheStructure) {
+    // A crumb of 2 x 2 x 2 particles (one lattice cell) three spacings beside the bar, meshed
+    // apart from it: a piece of a body that no crack cut off (as a remesh may leave one beside
+    // a crack). When the bar cracks, it must not leave as a fragment of a few grams.
+    test::Simulation sim(
+        pulled_bar(true, R"({ "type": "box", "min": [0.5, 0.35, 0], "max": [0.6, 0.45, 0.1] })"));
+    const PorousParticles& p = sim.state.porous.particles;
+    std::vector<Index> crumb;
+    for (Index i = 0; i < p.size(); ++i)
+        if (p.x[i][1] > 0.3) crumb.push_back(p.id[i]);
+    ASSERT_EQ(crumb.size(), 8u);
+    const Structure& s = sim.state.structures.structures.at(0);
+    Index pieces = 0;
+    tet_components(s.mesh.tet_count(), s.links, pieces);
+    ASSERT_EQ(pieces, 2) << "the crumb is meshed apart from the bar";
+    sim.advance();
+    EXPECT_GE(sim.state.structures.fracture.fragments_created, 1) << "the bar broke";
+    const Index anchored = s.fragment;
+    const std::vector<Index> index_of = index_by_id(p, sim.state.structures.node_of.size());
+    for (Index id : crumb) EXPECT_EQ(p.fragment[index_of[id]], anchored) << "particle " << id;
+    // Every free fragment is a piece of the bar, over the resolution.
+    std::vector<Index> members(sim.state.porous.fragments.size(), 0);
+    for (Index i = 0; i < p.size(); ++i) ++members[p.fragment[i]];
+    for (size_t f = 0; f < members.size(); ++f)
+        if (Index(f) != anchored && members[f] > 0) {
+            EXPECT_GE(members[f], 16) << "fragment " << f;
+        }
 }
 
 TEST(FractureScene, TheCrackSetDoesNotDependOnTheParticleOrder) {

@@ -212,6 +212,12 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         if (stays < 0) stays = biggest_of(std::vector<char>(split.components, 1));
         anchored[stays] = 1;
     }
+    // A piece under the resolution that no cut of this call made stays too, as a piece the Biot
+    // solve balances (biot_setup.hpp unheld_pieces): a remesh's drop of the tets across a crack
+    // can leave a few tets beside it linked to nothing. Freed, each became a fragment of a few
+    // grams that the fluid's pressure solve could not hold: it diverged and flung one at 30 m/s.
+    for (Index c = 0; c < split.components; ++c)
+        if (tets_in[c] < k_min_piece_tets) anchored[c] = 1;
     std::vector<char> keep(split.mesh.tet_count());
     for (Index e = 0; e < split.mesh.tet_count(); ++e) keep[e] = anchored[split.component[e]];
 
