@@ -278,18 +278,18 @@ TEST(MeshSplit, SmallPiecesAreSparedUnlessTheyStayAnchored) {
 }
 
 /// A bar 1 x 0.3 x 0.3 m on the lattice, its links, and those a crack disk at x = 0.5 with
-/// normal x, centred at (y, z), cuts.
+/// normal x (unless given), centred at (y, z), cuts.
 struct CutBar {
     TetMesh mesh;
     std::vector<ElementLink> links;
     std::vector<char> broken;
 
-    CutBar(Real y, Real z, Real radius) {
+    CutBar(Real y, Real z, Real radius, const Vec3& normal = Vec3::UnitX()) {
         const std::vector<Vec3> nodes = box_lattice_nodes(Vec3::Zero(), Vec3(1, 0.3, 0.3), k_dx);
         mesh = build_tet_mesh(nodes, std::vector<Real>(nodes.size(), k_dx), MeshOptions{});
         links = face_links(mesh);
         Crack c;
-        c.centre = Vec3(0.5, y, z), c.normal = Vec3::UnitX(), c.radius = radius;
+        c.centre = Vec3(0.5, y, z), c.normal = normal.normalized(), c.radius = radius;
         const std::vector<Index> cutter = links_cut(mesh, links, std::span(&c, 1));
         for (Index k : cutter) broken.push_back(k >= 0);
     }
@@ -339,6 +339,79 @@ TEST(MeshSplit, ARemeshOfACrackedBarKeepsTheCrackOpen) {
     Index pieces = 0;
     tet_components(fresh.tet_count(), face_links(fresh), pieces);
     EXPECT_EQ(pieces, 1);
+}
+
+TEST(MeshSplit, ARemeshOfAnObliquelyCrackedBarKeepsItsTetsAndMeshesOnlyTheNewPoints) {
+    // An oblique crack through the whole section: two pieces, their copies moved off the crack.
+    const CutBar bar(0.1, 0.13, 0.5, Vec3(1, 0.6, 0.35));
+    const MeshSplit split = split_mesh(bar.mesh, bar.links, bar.broken, 0.05 * k_dx);
+    ASSERT_EQ(split.components, 2);
+    const Index n_split = split.mesh.node_count();
+    // The structure's mesh keeps each copy where its source was; the particles sit off it.
+    TetMesh old = split.mesh;
+    for (Index k = 0; k < n_split; ++k) old.nodes[k] = bar.mesh.nodes[split.source[k]];
+    std::vector<char> source_on_crack(bar.mesh.node_count(), 0);
+    for (size_t k = 0; k < bar.links.size(); ++k)
+        if (bar.broken[k])
+            for (Index a : shared_nodes(bar.mesh, bar.links[k])) source_on_crack[a] = 1;
+    // The remesh: the bar's corner node (1, 0.3, 0.3) is lost, a block of 8 new particles
+    // lies against the side y = 0.3.
+    std::vector<Vec3> x;
+    std::vector<Index> old_node;
+    std::vector<char> on_crack;
+    Index lost = -1;
+    for (Index k = 0; k < n_split; ++k) {
+        if ((old.nodes[k] - Vec3(1, 0.3, 0.3)).norm() < 1e-9) {
+            lost = k;
+            continue;
+        }
+        x.push_back(split.mesh.nodes[k]), old_node.push_back(k);
+        on_crack.push_back(source_on_crack[split.source[k]]);
+    }
+    ASSERT_GE(lost, 0);
+    const std::vector<Vec3> added = box_lattice_nodes(Vec3(0.2, 0.4, 0), Vec3(0.3, 0.5, 0.1), k_dx);
+    for (const Vec3& p : added) x.push_back(p), old_node.push_back(-1), on_crack.push_back(0);
+    const Index n = Index(x.size());
+    TetMesh fresh = build_tet_mesh(x, std::vector<Real>(size_t(n), k_dx), MeshOptions{});
+    ASSERT_EQ(fresh.node_count(), n);
+    // A fresh triangulation with the drop alone splits the lattice cells otherwise than the old
+    // mesh: its tets cross the crack surface, and dropping them leaves crack nodes under-meshed.
+    TetMesh dropped_only = fresh;
+    drop_tets_across_cracks(dropped_only, old, split.links, old_node, on_crack);
+    const auto nodal_volume = [&](const TetMesh& m) {
+        std::vector<Real> v(m.node_count(), 0);
+        for (Index e = 0; e < m.tet_count(); ++e)
+            for (Index a : m.tets[e]) v[a] += m.tet_volume(e) / 4;
+        return v;
+    };
+    const std::vector<Real> before = nodal_volume(old);
+    const auto least_crack_volume = [&](const TetMesh& m) {  // relative to the split mesh's
+        const std::vector<Real> v = nodal_volume(m);
+        Real least = 1e9;
+        for (Index a = 0; a < n; ++a)
+            if (on_crack[a]) least = std::min(least, v[a] / before[old_node[a]]);
+        return least;
+    };
+    EXPECT_LT(least_crack_volume(dropped_only), 0.25);
+    keep_old_tets(fresh, old, old_node);
+    drop_tets_across_cracks(fresh, old, split.links, old_node, on_crack);
+    // Every old tet off the lost node is kept, so each crack node keeps its volume (within the
+    // copies' offset of 0.05 dx), the crack stays as it was, and the new particles are meshed
+    // onto one side: still two pieces.
+    Index off_lost = 0;
+    for (const Tet& t : old.tets) off_lost += std::find(t.begin(), t.end(), lost) == t.end();
+    Index old_kept = 0;
+    for (const Tet& t : fresh.tets)
+        old_kept += std::all_of(t.begin(), t.end(), [&](Index a) { return old_node[a] >= 0; });
+    EXPECT_EQ(old_kept, off_lost);
+    EXPECT_GT(least_crack_volume(fresh), 0.8);
+    std::vector<char> meshed(n, 0);
+    for (const Tet& t : fresh.tets)
+        for (Index a : t) meshed[a] = 1;
+    for (Index a = n - Index(added.size()); a < n; ++a) EXPECT_TRUE(meshed[a]) << "new node " << a;
+    Index pieces = 0;
+    tet_components(fresh.tet_count(), face_links(fresh), pieces);
+    EXPECT_EQ(pieces, 2);
 }
 
 TEST(MeshSplit, ACutThroughABarSplitsItsNodesAndSharesTheirVolume) {

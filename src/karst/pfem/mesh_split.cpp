@@ -274,6 +274,25 @@ TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loos
     return out;
 }
 
+void keep_old_tets(TetMesh& fresh, const TetMesh& old_mesh, std::span<const Index> old_node) {
+    std::vector<Index> now(old_mesh.node_count(), -1);
+    for (size_t a = 0; a < old_node.size(); ++a)
+        if (old_node[a] >= 0) now[old_node[a]] = Index(a);
+    std::vector<Tet> tets;
+    for (const Tet& t : old_mesh.tets)
+        if (std::all_of(t.begin(), t.end(), [&](Index a) { return now[a] >= 0; }))
+            tets.push_back({now[t[0]], now[t[1]], now[t[2]], now[t[3]]});
+    for (const Tet& t : fresh.tets)
+        if (std::any_of(t.begin(), t.end(), [&](Index a) { return old_node[a] < 0; }))
+            tets.push_back(t);
+    fresh.tets = std::move(tets);
+    // Each tet its own element: the EDT groups of the fresh mesh no longer apply.
+    fresh.tet_polyhedron.resize(fresh.tets.size());
+    std::iota(fresh.tet_polyhedron.begin(), fresh.tet_polyhedron.end(), Index(0));
+    fresh.boundary = boundary_faces(fresh.tets);
+    fresh.quality.elements = fresh.tet_count();
+}
+
 Index drop_tets_across_cracks(TetMesh& mesh, const TetMesh& old_mesh,
                               std::span<const ElementLink> old_links,
                               std::span<const Index> old_node, std::span<const char> on_crack) {

@@ -55,6 +55,14 @@ Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
 TetMesh sub_mesh(const TetMesh& mesh, std::span<const char> keep, bool keep_loose_nodes,
                  std::vector<Index>& node_of, std::vector<Index>& tet_of);
 
+/// §4.10, §5.6: the remesh of a cracked body keeps every tet of `old_mesh` whose nodes all
+/// remain (`old_node[a]` is node a's index there, or -1 for a node new to the body) and takes
+/// from `fresh`, a triangulation of all the nodes, only the tets with a new node. The cracks
+/// stay as they were, with both faces meshed: a fresh triangulation of the lattice splits the
+/// cells otherwise than the old mesh did, and its tets cross the crack surface, which runs
+/// along the old tets' faces. Nodes are kept; the old tets come first.
+void keep_old_tets(TetMesh& fresh, const TetMesh& old_mesh, std::span<const Index> old_node);
+
 /// §5.6: a remesh keeps the cracks. Removes from `mesh` (a new triangulation of a cracked
 /// body's particles) every tet with two nodes that both lie on broken faces (`on_crack`) and that
 /// the mesh it replaces kept apart (no tet of one is, or is linked by `old_links` to, a tet of the

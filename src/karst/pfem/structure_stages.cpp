@@ -134,7 +134,10 @@ void build(const Model& model, State& state, size_t slot, bool new_rest_state) {
     const TetMesh old_mesh = std::move(s.mesh);
     const std::vector<ElementLink> old_links = std::move(s.links);
     s.mesh = mesh_points(model, x, st.timings);
-    drop_tets_across_cracks(s.mesh, old_mesh, old_links, old_node, on_crack);
+    if (std::find(on_crack.begin(), on_crack.end(), 1) != on_crack.end()) {
+        keep_old_tets(s.mesh, old_mesh, old_node);
+        drop_tets_across_cracks(s.mesh, old_mesh, old_links, old_node, on_crack);
+    }
     s.mesh_version = st.next_mesh_version++;
     s.mobility_scale.clear(), s.flow_time_step = -1;  // a new mesh's solver starts afresh
     s.split_of_version = -1, s.split_source.clear();
@@ -166,6 +169,12 @@ void build(const Model& model, State& state, size_t slot, bool new_rest_state) {
         s.well_shaped[e] =
             min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) >= k_distorted_dihedral_deg;
     }
+}
+
+/// Whether a crack has broken a face of the structure's mesh.
+bool cracked(const StructureState& st, const Structure& s) {
+    return std::any_of(s.node_id.begin(), s.node_id.end(),
+                       [&](Index id) { return st.damage[id] > 0; });
 }
 
 bool distorted(const Structure& s) {
@@ -265,7 +274,9 @@ void remesh_structures(const Model& model, State& state) {
             for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
         } else if (s.grown) {
             for (Index a = 0; a < n; ++a) st.u[s.node_id[a]] = s.fields.u[a];
-        } else if (s.distorted) {
+        } else if (s.distorted && !cracked(st, s)) {
+            // A cracked body keeps its mesh: a remesh keeps its old tets (build), and on the
+            // deformed positions as a new rest state those are the distorted ones.
             new_rest_state = true;
             // [D] A distorted mesh is rebuilt on the deformed positions, which become the new
             // rest state (u = 0 there): small-strain Biot cannot carry a deformation that inverts
