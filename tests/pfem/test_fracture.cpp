@@ -293,15 +293,21 @@ struct CutBar {
         const std::vector<Index> cutter = links_cut(mesh, links, std::span(&c, 1));
         for (Index k : cutter) broken.push_back(k >= 0);
     }
+
+    /// Per node of the bar, whether it lies on a broken face.
+    std::vector<char> on_crack() const {
+        std::vector<char> on(mesh.node_count(), 0);
+        for (size_t k = 0; k < links.size(); ++k)
+            if (broken[k])
+                for (Index a : shared_nodes(mesh, links[k])) on[a] = 1;
+        return on;
+    }
 };
 
 TEST(MeshSplit, ARemeshOfACrackedBarKeepsTheCrackOpen) {
     // A crack through the half of the section at y < 0.15: the bar stays one piece.
     const CutBar bar(0, 0.15, 0.16);
-    std::vector<char> source_on_crack(bar.mesh.node_count(), 0);
-    for (size_t k = 0; k < bar.links.size(); ++k)
-        if (bar.broken[k])
-            for (Index a : shared_nodes(bar.mesh, bar.links[k])) source_on_crack[a] = 1;
+    const std::vector<char> source_on_crack = bar.on_crack();
     const MeshSplit split = split_mesh(bar.mesh, bar.links, bar.broken, 0.05 * k_dx);
     ASSERT_EQ(split.components, 1);
     ASSERT_GT(split.split_nodes, 0);
@@ -350,10 +356,7 @@ TEST(MeshSplit, ARemeshOfAnObliquelyCrackedBarKeepsItsTetsAndMeshesOnlyTheNewPoi
     // The structure's mesh keeps each copy where its source was; the particles sit off it.
     TetMesh old = split.mesh;
     for (Index k = 0; k < n_split; ++k) old.nodes[k] = bar.mesh.nodes[split.source[k]];
-    std::vector<char> source_on_crack(bar.mesh.node_count(), 0);
-    for (size_t k = 0; k < bar.links.size(); ++k)
-        if (bar.broken[k])
-            for (Index a : shared_nodes(bar.mesh, bar.links[k])) source_on_crack[a] = 1;
+    const std::vector<char> source_on_crack = bar.on_crack();
     // The remesh: the bar's corner node (1, 0.3, 0.3) is lost, a block of 8 new particles
     // lies against the side y = 0.3.
     std::vector<Vec3> x;

@@ -134,9 +134,9 @@ TEST(FractureScene, APieceUnderTheResolutionThatNoCrackCutOffStaysInTheStructure
     Index pieces = 0;
     tet_components(s.mesh.tet_count(), s.links, pieces);
     ASSERT_EQ(pieces, 2) << "the crumb is meshed apart from the bar";
+    const Index anchored = s.fragment;
     sim.advance();
     EXPECT_GE(sim.state.structures.fracture.fragments_created, 1) << "the bar broke";
-    const Index anchored = s.fragment;
     const std::vector<Index> index_of = index_by_id(p, sim.state.structures.node_of.size());
     for (Index id : crumb) EXPECT_EQ(p.fragment[index_of[id]], anchored) << "particle " << id;
     // Every free fragment is a piece of the bar, over the resolution.

@@ -215,7 +215,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     // A piece under the resolution that no cut of this call made stays too, as a piece the Biot
     // solve balances (biot_setup.hpp unheld_pieces): a remesh's drop of the tets across a crack
     // can leave a few tets beside it linked to nothing. Freed, each became a fragment of a few
-    // grams that the fluid's pressure solve could not hold: it diverged and flung one at 30 m/s.
+    // grams that the fluid's pressure solve could not hold.
     for (Index c = 0; c < split.components; ++c)
         if (tets_in[c] < k_min_piece_tets) anchored[c] = 1;
     std::vector<char> keep(split.mesh.tet_count());

@@ -104,6 +104,12 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
 
 namespace {
 
+/// Whether a crack has broken a face of the structure's mesh.
+bool cracked(const StructureState& st, const Structure& s) {
+    return std::any_of(s.node_id.begin(), s.node_id.end(),
+                       [&](Index id) { return st.damage[id] > 0; });
+}
+
 /// Meshes structure `slot` on the rest positions of its fragment's present particles; u is
 /// carried per particle id, p starts at the drained pressure where drained and 0 elsewhere.
 /// With `new_rest_state` (a coupled run), the rest state is the new mesh standing under its
@@ -134,7 +140,7 @@ void build(const Model& model, State& state, size_t slot, bool new_rest_state) {
     const TetMesh old_mesh = std::move(s.mesh);
     const std::vector<ElementLink> old_links = std::move(s.links);
     s.mesh = mesh_points(model, x, st.timings);
-    if (std::find(on_crack.begin(), on_crack.end(), 1) != on_crack.end()) {
+    if (cracked(st, s)) {
         keep_old_tets(s.mesh, old_mesh, old_node);
         drop_tets_across_cracks(s.mesh, old_mesh, old_links, old_node, on_crack);
     }
@@ -169,12 +175,6 @@ void build(const Model& model, State& state, size_t slot, bool new_rest_state) {
         s.well_shaped[e] =
             min_dihedral_deg({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) >= k_distorted_dihedral_deg;
     }
-}
-
-/// Whether a crack has broken a face of the structure's mesh.
-bool cracked(const StructureState& st, const Structure& s) {
-    return std::any_of(s.node_id.begin(), s.node_id.end(),
-                       [&](Index id) { return st.damage[id] > 0; });
 }
 
 bool distorted(const Structure& s) {
