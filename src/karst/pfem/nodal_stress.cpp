@@ -1,9 +1,12 @@
 #include "karst/pfem/nodal_stress.hpp"
 
+#include "karst/core/parallel.hpp"
 #include "karst/pfem/p1_tet.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+
+#include <algorithm>
 
 namespace karst {
 
@@ -15,6 +18,63 @@ using Vec4 = Eigen::Matrix<Real, 4, 1>;
 /// A linear fit of the element strains around a node is trusted when its 4 x 4 normal matrix
 /// (offsets scaled by the patch size) has no eigenvalue below this fraction of the largest.
 constexpr Real k_min_fit_condition = 1e-4;
+
+using Row = Eigen::Matrix<Real, 1, 6>;  // a symmetric tensor: xx, yy, zz, xy, yz, xz
+
+Mat3 tensor(const Row& c) {
+    Mat3 m;
+    m << c(0), c(3), c(5), c(3), c(1), c(4), c(5), c(4), c(2);
+    return m;
+}
+
+using Fit = Eigen::Matrix<Real, 4, 6>;  // a node's patch fit: value, gradient times patch size
+
+/// A node on the surface (a crack face included) takes the fits of the interior nodes that share
+/// a tet with it, evaluated at it (an edge or corner node without one: those two tets away), as
+/// Zienkiewicz and Zhu recover boundary values: its own patch lies on one side of it and holds
+/// whichever tets the lattice's split put there. Sets value[a] and has[a] where it can.
+void recover_surface_from_interior(const TetMesh& mesh, const std::vector<Fit>& fit,
+                                   const std::vector<char>& fitted, const std::vector<Real>& size,
+                                   std::vector<Row>& value, std::vector<char>& has) {
+    const Index n = mesh.node_count();
+    std::vector<char> on_surface(n, 0);
+    for (const Triangle& f : mesh.boundary)
+        for (Index a : f) on_surface[a] = 1;
+    std::vector<std::vector<Index>> tets_of(n);
+    for (Index e = 0; e < mesh.tet_count(); ++e)
+        for (Index a : mesh.tets[e]) tets_of[a].push_back(e);
+    auto ring = [&](Index a) {
+        std::vector<Index> nodes;
+        for (Index e : tets_of[a])
+            for (Index b : mesh.tets[e])
+                if (b != a) nodes.push_back(b);
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        return nodes;
+    };
+    parallel_for(n, [&](Index a) {
+        if (!on_surface[a]) return;
+        std::vector<Index> near = ring(a);
+        auto interior = [&](Index b) { return !on_surface[b] && fitted[b]; };
+        if (std::none_of(near.begin(), near.end(), interior)) {
+            std::vector<Index> second;
+            for (Index b : near)
+                for (Index c : ring(b)) second.push_back(c);
+            std::sort(second.begin(), second.end());
+            second.erase(std::unique(second.begin(), second.end()), second.end());
+            near = std::move(second);
+        }
+        int used = 0;
+        for (Index b : near) {
+            if (!interior(b)) continue;
+            Vec4 basis;
+            basis << 1, (mesh.nodes[a] - mesh.nodes[b]) / size[b];
+            value[a] += basis.transpose() * fit[b];
+            ++used;
+        }
+        if (used > 0) value[a] /= used, has[a] = 1;
+    });
+}
 
 }  // namespace
 
@@ -28,6 +88,7 @@ NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
     // volume-weighted average the sheet names is first order: at a surface it reads the stress
     // of the element centroids inside, and a beam in bending cracked 16 % late. The average is
     // kept for eps_v (M23), which must stay the volume mean, and where the fit is ill-posed.
+    // Surface nodes read their interior neighbours' fits (recover_surface_from_interior).
     std::vector<Mat3> strain_sum(n, Mat3::Zero());
     std::vector<Real> volume(n, 0), size(n, 0);
     std::vector<Mat3> element_strain(mesh.tet_count());
@@ -47,7 +108,7 @@ NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
     std::vector<Eigen::Matrix<Real, 4, 6>> moments(n, Eigen::Matrix<Real, 4, 6>::Zero());
     for (Index e = 0; e < mesh.tet_count(); ++e) {
         const Mat3& s = element_strain[e];
-        Eigen::Matrix<Real, 1, 6> components;
+        Row components;
         components << s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2);
         for (Index a : mesh.tets[e]) {
             const Real w = volume[a] > 0 ? mesh.tet_volume(e) / volume[a] : 0;
@@ -57,6 +118,18 @@ NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
             moments[a] += w * basis * components;
         }
     }
+    std::vector<Fit> fit(n, Fit::Zero());
+    std::vector<char> fitted(n, 0);
+    for (Index a = 0; a < n; ++a) {
+        if (volume[a] <= 0) continue;
+        const Eigen::SelfAdjointEigenSolver<Mat4> conditioning(normal[a], Eigen::EigenvaluesOnly);
+        const Vec4 ev = conditioning.eigenvalues();
+        if (ev[0] > k_min_fit_condition * ev[3])
+            fit[a] = normal[a].ldlt().solve(moments[a]), fitted[a] = 1;
+    }
+    std::vector<Row> from_inside(n, Row::Zero());
+    std::vector<char> recovered_from_inside(n, 0);
+    recover_surface_from_interior(mesh, fit, fitted, size, from_inside, recovered_from_inside);
     NodalStress s;
     s.effective.resize(n), s.total.resize(n), s.principal.resize(n),
         s.principal_direction.resize(n);
@@ -64,16 +137,10 @@ NodalStress nodal_stress(const TetMesh& mesh, const BiotMaterial& material,
     for (Index a = 0; a < n; ++a) {
         const Mat3 mean = volume[a] > 0 ? Mat3(strain_sum[a] / volume[a]) : Mat3::Zero();
         Mat3 eps = mean;
-        if (volume[a] > 0) {
-            const Eigen::SelfAdjointEigenSolver<Mat4> conditioning(normal[a],
-                                                                   Eigen::EigenvaluesOnly);
-            const Vec4 ev = conditioning.eigenvalues();
-            if (ev[0] > k_min_fit_condition * ev[3]) {
-                const Eigen::Matrix<Real, 4, 6> fit = normal[a].ldlt().solve(moments[a]);
-                eps << fit(0, 0), fit(0, 3), fit(0, 5), fit(0, 3), fit(0, 1), fit(0, 4), fit(0, 5),
-                    fit(0, 4), fit(0, 2);
-            }
-        }
+        if (recovered_from_inside[a])
+            eps = tensor(from_inside[a]);
+        else if (fitted[a])
+            eps = tensor(fit[a].row(0));
         const Mat3 sigma = lambda * eps.trace() * Mat3::Identity() + 2 * mu * eps;
         s.effective[a] = sigma;
         s.total[a] = sigma - material.biot_coefficient * fields.p[a] * Mat3::Identity();
