@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <limits>
 
 namespace karst {
 
@@ -29,10 +30,10 @@ Mat3 tensor(const Row& c) {
 
 using Fit = Eigen::Matrix<Real, 4, 6>;  // a node's patch fit: value, gradient times patch size
 
-/// A node on the surface (a crack face included) takes the fits of the interior nodes that share
-/// a tet with it, evaluated at it (an edge or corner node without one: those two tets away), as
-/// Zienkiewicz and Zhu recover boundary values: its own patch lies on one side of it and holds
-/// whichever tets the lattice's split put there. Sets value[a] and has[a] where it can.
+/// A node on the surface (a crack face included) takes the mean of nearby interior nodes' fits,
+/// evaluated at it, as Zienkiewicz and Zhu recover boundary values: its own patch lies on one
+/// side of it and holds whichever tets the lattice's split put there. Sets value[a] and has[a]
+/// where it can.
 void recover_surface_from_interior(const TetMesh& mesh, const std::vector<Fit>& fit,
                                    const std::vector<char>& fitted, const std::vector<Real>& size,
                                    std::vector<Row>& value, std::vector<char>& has) {
@@ -54,16 +55,25 @@ void recover_surface_from_interior(const TetMesh& mesh, const std::vector<Fit>& 
     };
     parallel_for(n, [&](Index a) {
         if (!on_surface[a]) return;
-        std::vector<Index> near = ring(a);
+        // The interior nodes two tets away within a cell's diagonal (sqrt 3 times the shortest
+        // edge): chosen by distance, the set is as symmetric as the lattice whatever its split.
+        // Failing any, all interior nodes two tets away.
+        const std::vector<Index> first = ring(a);
+        Real shortest = std::numeric_limits<Real>::max();
+        for (Index b : first) shortest = std::min(shortest, (mesh.nodes[b] - mesh.nodes[a]).norm());
+        std::vector<Index> second;
+        for (Index b : first)
+            for (Index c : ring(b))
+                if (c != a) second.push_back(c);
+        std::sort(second.begin(), second.end());
+        second.erase(std::unique(second.begin(), second.end()), second.end());
         auto interior = [&](Index b) { return !on_surface[b] && fitted[b]; };
-        if (std::none_of(near.begin(), near.end(), interior)) {
-            std::vector<Index> second;
-            for (Index b : near)
-                for (Index c : ring(b)) second.push_back(c);
-            std::sort(second.begin(), second.end());
-            second.erase(std::unique(second.begin(), second.end()), second.end());
-            near = std::move(second);
-        }
+        std::vector<Index> near;
+        for (Index c : second)
+            if (interior(c) &&
+                (mesh.nodes[c] - mesh.nodes[a]).norm() <= 1.01 * std::sqrt(3.0) * shortest)
+                near.push_back(c);
+        if (near.empty()) near = second;
         int used = 0;
         for (Index b : near) {
             if (!interior(b)) continue;
