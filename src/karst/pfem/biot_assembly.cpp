@@ -33,7 +33,7 @@ void set_strain_displacement_columns(Matrix& B, int a, const Vec3& g) {
 void BiotSolver::Impl::assemble_p1_mechanics() {
     const BiotMaterial& m = problem.material;
     const Real lambda = m.lame_lambda(), mu = m.shear_modulus();
-    // Tets around each node, and each node's sorted neighbour nodes (itself included).
+    // Tets around each node; each node's sorted neighbour nodes (itself included).
     std::vector<Index> tet_start(n + 1, 0), tet_list(4 * mesh.tet_count());
     for (const Tet& t : mesh.tets)
         for (Index a : t) ++tet_start[a + 1];
@@ -43,14 +43,7 @@ void BiotSolver::Impl::assemble_p1_mechanics() {
         for (Index e = 0; e < mesh.tet_count(); ++e)
             for (Index a : mesh.tets[e]) tet_list[fill[a]++] = e;
     }
-    std::vector<std::vector<Index>> neighbours(n);
-    parallel_for(n, [&](Index b) {
-        auto& nb = neighbours[b];
-        for (Index k = tet_start[b]; k < tet_start[b + 1]; ++k)
-            for (Index a : mesh.tets[tet_list[k]]) nb.push_back(a);
-        std::sort(nb.begin(), nb.end());
-        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-    });
+    const std::vector<std::vector<Index>> neighbours = node_neighbours(mesh);
     auto free_u = [&](Index a, int c) { return u_dofs.free_index[3 * a + c]; };
 
     // Column pointers of K_ff (free dofs in order), Q (n columns of 3 rows per neighbour) and M.

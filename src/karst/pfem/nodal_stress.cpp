@@ -41,48 +41,33 @@ void recover_surface_from_interior(const TetMesh& mesh, const std::vector<Fit>& 
     std::vector<char> on_surface(n, 0);
     for (const Triangle& f : mesh.boundary)
         for (Index a : f) on_surface[a] = 1;
-    std::vector<std::vector<Index>> tets_of(n);
-    for (Index e = 0; e < mesh.tet_count(); ++e)
-        for (Index a : mesh.tets[e]) tets_of[a].push_back(e);
-    auto ring = [&](Index a) {
-        std::vector<Index> nodes;
-        for (Index e : tets_of[a])
-            for (Index b : mesh.tets[e])
-                if (b != a) nodes.push_back(b);
-        std::sort(nodes.begin(), nodes.end());
-        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-        return nodes;
-    };
+    const std::vector<std::vector<Index>> neighbours = node_neighbours(mesh);
+    auto interior = [&](Index b) { return !on_surface[b] && fitted[b]; };
     parallel_for(n, [&](Index a) {
         if (!on_surface[a]) return;
         // The interior nodes two tets away within a cell's diagonal (sqrt 3 times the shortest
         // edge): chosen by distance, the set is as symmetric as the lattice whatever its split.
         // Failing any, all interior nodes two tets away.
-        const std::vector<Index> first = ring(a);
         Real shortest = std::numeric_limits<Real>::max();
-        for (Index b : first) shortest = std::min(shortest, (mesh.nodes[b] - mesh.nodes[a]).norm());
-        std::vector<Index> second;
-        for (Index b : first)
-            for (Index c : ring(b))
-                if (c != a) second.push_back(c);
-        std::sort(second.begin(), second.end());
-        second.erase(std::unique(second.begin(), second.end()), second.end());
-        auto interior = [&](Index b) { return !on_surface[b] && fitted[b]; };
+        std::vector<Index> candidates;
+        for (Index b : neighbours[a]) {
+            if (b != a) shortest = std::min(shortest, (mesh.nodes[b] - mesh.nodes[a]).norm());
+            for (Index c : neighbours[b])
+                if (interior(c)) candidates.push_back(c);
+        }
+        std::sort(candidates.begin(), candidates.end());
+        candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
         std::vector<Index> near;
-        for (Index c : second)
-            if (interior(c) &&
-                (mesh.nodes[c] - mesh.nodes[a]).norm() <= 1.01 * std::sqrt(3.0) * shortest)
+        for (Index c : candidates)
+            if ((mesh.nodes[c] - mesh.nodes[a]).norm() <= 1.01 * std::sqrt(3.0) * shortest)
                 near.push_back(c);
-        if (near.empty()) near = second;
-        int used = 0;
+        if (near.empty()) near = std::move(candidates);
         for (Index b : near) {
-            if (!interior(b)) continue;
             Vec4 basis;
             basis << 1, (mesh.nodes[a] - mesh.nodes[b]) / size[b];
             value[a] += basis.transpose() * fit[b];
-            ++used;
         }
-        if (used > 0) value[a] /= used, has[a] = 1;
+        if (!near.empty()) value[a] /= Real(near.size()), has[a] = 1;
     });
 }
 

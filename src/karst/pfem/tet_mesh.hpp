@@ -58,6 +58,10 @@ struct TetMesh {
 TetMesh build_tet_mesh(std::span<const Vec3> points, std::span<const Real> node_size,
                        const MeshOptions& options, std::span<const Real> weights = {});
 
+/// Each node's neighbours, the nodes that share a tet with it, sorted, the node itself included
+/// where it has a tet (pfem/tet_adjacency.cpp).
+std::vector<std::vector<Index>> node_neighbours(const TetMesh& mesh);
+
 /// Volume of the tet (a, b, c, d): positive when (b - a, c - a, d - a) is right-handed, m^3.
 Real signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
