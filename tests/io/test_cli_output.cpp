@@ -156,4 +156,31 @@ TEST(Cli, WatchdogStopsWithOneAfterWritingTheLastGoodFrame) {
     EXPECT_TRUE(fs::exists(out / last));
 }
 
+TEST(Cli, AWatchdogStopRightAfterAFrameRepeatsNoFrameTime) {
+    // At 2000 frames per second every step ends on a frame, so the last good state is already a
+    // frame when the watchdog stops the next step: it must not be written again at the same time
+    // (ParaView's run.pvd and mesh.case need increasing times).
+    TempDir dir("cli_watchdog_frame");
+    std::string scene = k_tiny;
+    scene.replace(scene.find("\"output\""), 8, "\"watchdog\": { \"max_speed\": 0.3 }, \"output\"");
+    std::ofstream(dir.path / "w.json") << scene;
+    const fs::path out = dir.path / "out";
+    EXPECT_EQ(karst("run " + (dir.path / "w.json").string() + " --out " + out.string() +
+                    " --quiet --threads 1 --fps 2000"),
+              1);
+    std::istringstream log(read_text(out / "log.csv"));
+    std::string line;
+    std::getline(log, line);  // header
+    double last = -1;
+    int rows = 0;
+    while (std::getline(log, line)) {
+        const double time = std::stod(line.substr(line.find(',') + 1));
+        EXPECT_GT(time, last) << line;
+        last = time, ++rows;
+    }
+    EXPECT_GE(rows, 5);
+    const int frames = nlohmann::json::parse(read_text(out / "stats.json"))["frames"];
+    EXPECT_EQ(frames, rows);
+}
+
 }  // namespace

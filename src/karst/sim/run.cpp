@@ -369,12 +369,15 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 report = step(model, state, dt, record.profile);
                 record.frame_step_seconds += step_watch.seconds();
             } catch (const WatchdogError&) {
-                // Keep what was good: the state before the failing step becomes the last frame.
+                // Keep what was good: the state before the failing step becomes the last frame,
+                // unless the last frame already shows it (a frame was due at its time).
                 state.fluid = last_good;
                 if (porous) state.porous = last_good_porous;
                 state.time = last_good_time;
-                write_frame({state.time, dt, state.steps, state.fluid.size(),
-                             record.frame_density_error, 0});
+                const std::vector<FrameLog>& written = out->history().log;
+                if (written.empty() || written.back().time < state.time)
+                    write_frame({state.time, dt, state.steps, state.fluid.size(),
+                                 record.frame_density_error, 0});
                 throw;
             }
             record.max_density_error = std::max(record.max_density_error, report.max_density_error);
