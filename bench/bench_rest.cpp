@@ -6,8 +6,7 @@
 // and pushed back from walls, steps and seconds, and the density solve's mean iterations and
 // the share of steps that ended at its cap (a solve stopped unconverged), and the largest
 // compression rho_i / rho0 - 1 at the end (a solver that holds the velocities but lets the
-// density drift shows here). A run the watchdog stops
-// is reported with its message.
+// density drift shows here). A run the watchdog stops is reported with its message.
 //
 //   karst_bench_rest [--scene NAME|all] [--solver dfsph|pcisph|both] [--end T]
 //                    [--dt-max S] [--tolerance ETA] [--divergence-tolerance ETA]

@@ -136,12 +136,17 @@ TEST(Cli, BadSceneExitsWithTwoAndWritesNothing) {
     EXPECT_EQ(karst("check " + (dir.path / "good.json").string()), 0);
 }
 
+/// The tiny scene with a watchdog at 0.3 m/s, as dir/w.json: its block falls faster than that
+/// within 0.05 s.
+void write_watchdog_scene(const fs::path& dir) {
+    std::string scene = k_tiny;
+    scene.replace(scene.find("\"output\""), 8, "\"watchdog\": { \"max_speed\": 0.3 }, \"output\"");
+    std::ofstream(dir / "w.json") << scene;
+}
+
 TEST(Cli, WatchdogStopsWithOneAfterWritingTheLastGoodFrame) {
     TempDir dir("cli_watchdog");
-    std::string scene = k_tiny;
-    // The block falls: its speed passes 0.3 m/s within 0.05 s.
-    scene.replace(scene.find("\"output\""), 8, "\"watchdog\": { \"max_speed\": 0.3 }, \"output\"");
-    std::ofstream(dir.path / "w.json") << scene;
+    write_watchdog_scene(dir.path);
     const fs::path out = dir.path / "out";
     EXPECT_EQ(
         karst("run " + (dir.path / "w.json").string() + " --out " + out.string() + " --quiet"), 1);
@@ -161,9 +166,7 @@ TEST(Cli, AWatchdogStopRightAfterAFrameRepeatsNoFrameTime) {
     // frame when the watchdog stops the next step: it must not be written again at the same time
     // (ParaView's run.pvd and mesh.case need increasing times).
     TempDir dir("cli_watchdog_frame");
-    std::string scene = k_tiny;
-    scene.replace(scene.find("\"output\""), 8, "\"watchdog\": { \"max_speed\": 0.3 }, \"output\"");
-    std::ofstream(dir.path / "w.json") << scene;
+    write_watchdog_scene(dir.path);
     const fs::path out = dir.path / "out";
     EXPECT_EQ(karst("run " + (dir.path / "w.json").string() + " --out " + out.string() +
                     " --quiet --threads 1 --fps 2000"),
