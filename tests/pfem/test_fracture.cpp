@@ -68,9 +68,12 @@ struct Sample {
     }
 
     std::vector<Crack> cracks(CrackCriterion criterion = CrackCriterion::Rankine) const {
+        return cracks(settings(k_strength, criterion));
+    }
+    std::vector<Crack> cracks(const CrackSettings& with) const {
         std::vector<Index> ids(mesh.node_count());
         for (Index a = 0; a < mesh.node_count(); ++a) ids[a] = a;
-        return find_cracks(mesh, stress, ids, settings(k_strength, criterion));
+        return find_cracks(mesh, stress, ids, with);
     }
 };
 
@@ -150,6 +153,77 @@ TEST(Cracks, TheExtensionStrainCracksTensionAtTheStrengthAndSplitsCompressionAlo
             EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
         }
     }
+}
+
+/// Rankine at `tensile` with a Mohr-Coulomb shear test at sigma_c and phi (degrees).
+CrackSettings mohr_coulomb(Real tensile, Real compressive, Real phi_deg) {
+    CrackSettings s = settings(tensile);
+    s.compressive_strength = compressive, s.friction_angle = phi_deg * std::numbers::pi / 180;
+    return s;
+}
+
+TEST(Cracks, MohrCoulombCracksUniaxialCompressionAtItsStrengthAlongTheFailurePlane) {
+    const Real compressive = 4 * k_strength;
+    const Vec3 size(1.2, 0.3, 0.3);
+    for (const Real phi : {0.0, 30.0, 45.0})
+        for (const Mat3& turn : {Mat3(Mat3::Identity()), turned_30_about_two_axes()}) {
+            const CrackSettings with = mohr_coulomb(k_strength, compressive, phi);
+            EXPECT_TRUE(Sample(size, turn, uniaxial(-0.95 * compressive)).cracks(with).empty());
+            const Sample pressed(size, turn, uniaxial(-1.05 * compressive));
+            EXPECT_TRUE(pressed.cracks().empty()) << "Rankine alone";
+            const std::vector<Crack> slips = pressed.cracks(with);
+            ASSERT_FALSE(slips.empty()) << phi;
+            for (const Crack& c : slips) {
+                // The plane at 45 + phi/2 to the plane the load acts on: its normal at that
+                // angle to the load axis.
+                EXPECT_NEAR(angle_deg(c.normal, turn * Vec3::UnitX()), 45 + phi / 2, 5) << phi;
+                EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
+            }
+        }
+}
+
+TEST(Cracks, MohrCoulombSlipsInPureShearAtTheCohesionAndNeverUnderHydrostaticCompression) {
+    // Tensile strength out of reach: pure shear tau fails at c cos phi = sigma_c (1 - sin phi) / 2.
+    for (const Real phi : {0.0, 30.0}) {
+        const Real compressive = 4 * k_strength;
+        const Real tau = compressive * (1 - std::sin(phi * std::numbers::pi / 180)) / 2;
+        const CrackSettings with = mohr_coulomb(1e3 * k_strength, compressive, phi);
+        Mat3 shear = Mat3::Zero();
+        shear(0, 1) = shear(1, 0) = 0.95 * tau;
+        EXPECT_TRUE(Sample(Vec3(0.6, 0.6, 0.3), Mat3::Identity(), shear).cracks(with).empty());
+        shear *= 1.05 / 0.95;
+        const std::vector<Crack> slips =
+            Sample(Vec3(0.6, 0.6, 0.3), Mat3::Identity(), shear).cracks(with);
+        ASSERT_FALSE(slips.empty());
+        for (const Crack& c : slips) {
+            EXPECT_NEAR(c.stress_ratio, 1.05, 0.01);
+            // At 45 - phi/2 to the tension (1, 1, 0), in the plane z = 0.
+            EXPECT_NEAR(angle_deg(c.normal, Vec3(1, 1, 0)), 45 - phi / 2, 5);
+            EXPECT_LT(std::abs(c.normal.z()), 0.05);
+        }
+    }
+    const Sample squeezed(Vec3(0.6, 0.4, 0.5), Mat3::Identity(),
+                          -100 * k_strength * Mat3::Identity());
+    EXPECT_TRUE(squeezed.cracks(mohr_coulomb(k_strength, 4 * k_strength, 30)).empty());
+}
+
+TEST(Cracks, TheMohrCoulombPlaneChosenLetsTheOuterWedgeSlideDown) {
+    // A column's foot under its weight (vertical compression): beside the +x face, the plane
+    // dips towards that face at 45 + phi/2 from the horizontal, so the wedge outside it rests on
+    // a slope, not on the floor: the normal points out and up.
+    const Mat3 sigma = Vec3(0, 0, -1e4).asDiagonal();
+    const Real theta = std::numbers::pi / 4 - std::numbers::pi / 12;  // phi = 30 degrees
+    const Vec3 down(0, 0, -1);
+    for (const Real side : {1.0, -1.0}) {
+        const Vec3 n = mohr_coulomb_normal(sigma, std::numbers::pi / 6, Vec3(side, 0, -0.2), down);
+        EXPECT_NEAR(n.x(), side * std::cos(theta), 1e-12);
+        EXPECT_NEAR(n.z(), std::sin(theta), 1e-12);
+    }
+    // Turned with the world, gravity included, the plane turns with them.
+    const Mat3 turn = turned_30_about_two_axes();
+    const Vec3 n = mohr_coulomb_normal(turn * sigma * turn.transpose(), std::numbers::pi / 6,
+                                       turn * Vec3(1, 0, -0.2), turn * down);
+    EXPECT_LT((n - turn * Vec3(std::cos(theta), 0, std::sin(theta))).norm(), 1e-12);
 }
 
 TEST(Cracks, ANodeCracksAtItsScaledStrength) {

@@ -377,6 +377,27 @@ TEST(FractureScene, ABarUnderARampedTractionCracksAtItsStrengthNormalToTheLoad) 
         EXPECT_GT(std::abs(c.normal[0]), std::cos(5 * std::numbers::pi / 180));
 }
 
+TEST(FractureScene, ABarUnderARampedCompressionSlipsAtItsCompressiveStrengthOnTheShearPlane) {
+    // Mohr-Coulomb at sigma_c = 4 sigma_t, phi = 30 degrees: the compression rises by 1 % of
+    // sigma_c per call; Rankine alone never cracks it.
+    const std::string ramp = R"(
+      { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
+      { "kind": "traction", "traction": [4e5, 0, 0], "table": [[0, 0], [2, 2]],
+        "region": { "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] } },
+      { "kind": "traction", "traction": [-4e5, 0, 0], "table": [[0, 0], [2, 2]],
+        "region": { "type": "box", "min": [1.2, -1, -1], "max": [2, 2, 2] } })";
+    test::Simulation sim(
+        free_bar(ramp, R"(, "compressive_strength": 4e5, "friction_angle": 30)", 1e8));
+    const Real t = first_crack_time(sim, 2);
+    ASSERT_GT(t, 0) << "no crack under twice the compressive strength";
+    EXPECT_GE(t, 0.95);
+    EXPECT_LE(t, 1.05);
+    for (const CrackRecord& c : sim.state.structures.cracks)  // 60 degrees off the load axis
+        EXPECT_NEAR(std::abs(c.normal[0]), 0.5, std::sin(5 * std::numbers::pi / 180));
+    test::Simulation rankine(free_bar(ramp, "", 1e8));
+    EXPECT_LT(first_crack_time(rankine, 2), 0) << "Rankine cracked a bar in compression";
+}
+
 TEST(FractureScene, WaterWeakensTheBarLinearlyWithItsSaturationToItsWetStrength) {
     // The ramp of the test above on bars at S = 1 and S = 0.5 with a wet strength half the dry
     // one: they crack at 0.5 and 0.75 of the dry strength. The bars are stiff, so that their

@@ -85,6 +85,19 @@ TEST(SceneErrors, MissingRequiredKeyAndBadEnum) {
     EXPECT_NE(e.expected.find("\"sphere\""), std::string::npos);
 }
 
+TEST(SceneErrors, ACompressiveStrengthBelowTheTensileIsRefused) {
+    const std::string solid = replace(
+        k_valid, "\"walls\"",
+        R"("porous_solids": [ { "shape": { "type": "box", "min": [0.3, 0.3, 0], "max": [0.45, 0.45, 0.15] },
+      "material": { "tensile_strength": 5e4, "compressive_strength": 4e4 } } ],
+  "walls")");
+    const SceneError e = refuse(solid);
+    EXPECT_EQ(e.path, "/porous_solids/0/material/compressive_strength");
+    EXPECT_NE(e.expected.find("above the tensile strength"), std::string::npos) << e.expected;
+    EXPECT_EQ(e.found, "40000.0");
+    EXPECT_NO_THROW(build_model(parse_scene(replace(solid, "4e4", "4e5"))));
+}
+
 TEST(SceneErrors, InvalidJsonSyntax) {
     const SceneError e = refuse("{ \"name\": ");
     EXPECT_NE(e.found.find("syntax error"), std::string::npos);

@@ -3,12 +3,14 @@
 #include "karst/pfem/rigid_modes.hpp"
 
 #include "karst/core/timer.hpp"
+#include "karst/pfem/cracks.hpp"
 #include "karst/pfem/face_links.hpp"
 #include "karst/pfem/mesh_split.hpp"
 #include "karst/pfem/porosity.hpp"
 
 #include <algorithm>
 #include <array>
+#include <numbers>
 #include <optional>
 
 namespace karst {
@@ -324,6 +326,10 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
     for (Index a = 0; a < n; ++a) {
         permeability[a] = (feedback ? pore.permeability_scale[a] : Real(1)) * node_tensors[a];
         crack[a] = stress.principal[a][0] / material.tensile_strength;
+        if (material.compressive_strength)
+            crack[a] = std::max(
+                crack[a], mohr_coulomb_ratio(stress.principal[a], *material.compressive_strength,
+                                             material.friction_angle * std::numbers::pi / 180));
     }
     PointSet local;
     local.add_vector("displacement", fields.u);

@@ -95,7 +95,8 @@ void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMater
 /// Appends the mesh (nodes at `mesh.nodes`, tets) to `frame`, with the point arrays
 /// displacement, pore_pressure, porosity and permeability (6 components) as the pores use them
 /// (the call's M23 and M24 with `feedback`, else the rest values phi0 and K0), effective_stress
-/// (6), principal_stress (3), crack_candidate (sigma'_1 / sigma_t, M25) and support_force (3,
+/// (6), principal_stress (3), crack_candidate (sigma'_1 / sigma_t, M25, or the Mohr-Coulomb
+/// ratio where that is larger and the material has a compressive strength) and support_force (3,
 /// zero where `support_force` does not cover the mesh: no call on it yet). The stresses are
 /// those of `carried` (the fields with u from the unloaded mesh, fields_with_weight), the rest
 /// those of `fields`.

@@ -65,6 +65,28 @@ std::vector<std::pair<Real, Vec3>> separation_tensor_ratios(const TetMesh& mesh,
     return result;
 }
 
+Real mohr_coulomb_ratio(const Vec3& s, Real compressive_strength, Real friction_angle) {
+    const Real sine = std::sin(friction_angle);
+    return ((s[0] - s[2]) + (s[0] + s[2]) * sine) / (compressive_strength * (1 - sine));
+}
+
+Vec3 mohr_coulomb_normal(const Mat3& sigma, Real friction_angle, const Vec3& outward,
+                         const Vec3& down) {
+    const Eigen::SelfAdjointEigenSolver<Mat3> eigen(sigma);  // eigenvalues ascending
+    const Vec3& lambda = eigen.eigenvalues();
+    Vec3 least = eigen.eigenvectors().col(2), most = eigen.eigenvectors().col(0);
+    // With the two least compressive stresses equal (a column under its weight), any direction
+    // across the load is e1: take the one pointing out.
+    const Vec3 across = outward - outward.dot(most) * most;
+    if (lambda[2] - lambda[1] <= 1e-6 * (lambda[2] - lambda[0]) && across.norm() > 0)
+        least = across.normalized();
+    if (least.dot(outward) < 0) least = -least;
+    const bool by_gravity = std::abs(most.dot(down)) > 1e-3;
+    if (by_gravity ? most.dot(down) > 0 : most.dot(outward) < 0) most = -most;
+    const Real theta = std::numbers::pi / 4 - friction_angle / 2;
+    return std::cos(theta) * least + std::sin(theta) * most;
+}
+
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                                std::span<const Index> node_id, const CrackSettings& settings,
                                const std::function<bool(const Crack&)>& accept) {
@@ -75,6 +97,12 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                    : std::vector<std::pair<Real, Vec3>>{};
     const bool strain = settings.criterion == CrackCriterion::ExtensionStrain;
     const Real nu = settings.poisson_ratio;
+    const bool shear = settings.compressive_strength > 0;
+    Vec3 centroid = Vec3::Zero();
+    if (shear) {
+        for (const Vec3& x : mesh.nodes) centroid += x;
+        centroid /= Real(std::max<Index>(mesh.node_count(), 1));
+    }
     for (Index a = 0; a < mesh.node_count(); ++a) {
         const Vec3& s = stress.principal[a];
         const Real first = strain ? s[0] - nu * (s[1] + s[2]) : s[0];  // E eps_1 or sigma'_1
@@ -88,6 +116,13 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                 (strain ? normal - nu * (stress.effective[a].trace() - normal) : normal) /
                 settings.strength_across;
             if (across > ratio) ratio = across, n = m;
+        }
+        if (shear && std::isfinite(s[0])) {
+            const Real slip =
+                mohr_coulomb_ratio(s, settings.compressive_strength, settings.friction_angle);
+            if (slip > ratio)
+                ratio = slip, n = mohr_coulomb_normal(stress.effective[a], settings.friction_angle,
+                                                      mesh.nodes[a] - centroid, settings.down);
         }
         if (!settings.strength_scale.empty()) ratio /= settings.strength_scale[a];
         if (!(ratio > 1)) continue;

@@ -6,6 +6,7 @@
 #include "karst/scene/scene.hpp"
 
 #include <functional>
+#include <numbers>
 #include <span>
 
 namespace karst {
@@ -34,7 +35,27 @@ struct CrackSettings {
     Real poisson_ratio = 0.25;   ///< nu of the extension strain
     /// Per node: its strengths over the material's (wet weakening, fracture_stage.cpp). Empty: 1.
     std::vector<Real> strength_scale;
+    /// Mohr-Coulomb shear failure beside the tensile test: the uniaxial compressive strength
+    /// sigma_c (0: no shear test) and the friction angle phi.
+    Real compressive_strength = 0;               ///< Pa
+    Real friction_angle = std::numbers::pi / 6;  ///< rad
+    Vec3 down = Vec3::Zero();  ///< unit direction of gravity in the mesh's frame (zero: none)
 };
+
+/// Mohr-Coulomb (M25, shear): with the effective principal stresses s (tension positive,
+/// largest first), the shear stress on the weakest plane over the strength there,
+/// [(s1 - s3) + (s1 + s3) sin phi] / [sigma_c (1 - sin phi)]: 1 at failure, reached by uniaxial
+/// compression sigma_c and pure shear c cos phi; hydrostatic compression never reaches it.
+Real mohr_coulomb_ratio(const Vec3& principal, Real compressive_strength, Real friction_angle);
+
+/// The normal of the Mohr-Coulomb failure plane at stress sigma: in the plane of the least (e1)
+/// and most (e3) compressive directions, at 45 - phi/2 degrees to e1 (the plane itself at
+/// 45 + phi/2 to the plane e3 acts on). Of the two conjugate planes, the one whose outer wedge
+/// slides down: e1 pointing along `outward` and the normal's e3 part against `down` (along
+/// `outward` where gravity is zero or lies in the plane of e1 and e2). Where e1 is not unique
+/// (s1 = s2), it is `outward` across e3.
+Vec3 mohr_coulomb_normal(const Mat3& sigma, Real friction_angle, const Vec3& outward,
+                         const Vec3& down);
 
 /// O'Brien & Hodgins 1999 at each node a: the element forces f_e = -V_e sigma'_e grad N_a, split
 /// by the tensile and compressive parts of sigma'_e (sigma'_e the mean of its nodes'), give
@@ -55,8 +76,10 @@ std::vector<std::pair<Real, Vec3>> separation_tensor_ratios(const TetMesh& mesh,
 /// largest principal strain E eps_1 = sigma'_1 - nu (sigma'_2 + sigma'_3) takes the place of
 /// sigma'_1 (and the strain across the layers that of the stress across them): the same in
 /// uniaxial tension, but a bar in uniaxial compression splits along the load once nu times the
-/// compression exceeds sigma_t, as brittle rock and soil do. Each node's ratios are divided by
-/// its strength_scale. In decreasing ratio (ties by the node's particle id,
+/// compression exceeds sigma_t, as brittle rock and soil do. With a compressive strength, a node
+/// also cracks in shear (mohr_coulomb_ratio, its normal from mohr_coulomb_normal with `outward`
+/// pointing from the mesh's centroid), whichever ratio is larger. Each node's ratios are divided
+/// by its strength_scale. In decreasing ratio (ties by the node's particle id,
 /// so the order of the particles does not matter), skipping nodes within `exclusion` of a crack
 /// already taken and cracks for which `accept` (when given) is false, at most `max_cracks`.
 std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,

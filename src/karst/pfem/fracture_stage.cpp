@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace karst {
 
@@ -74,6 +75,12 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     settings.max_cracks = model.scene.fracture.max_cracks_per_call;
     settings.criterion = model.scene.fracture.criterion;
     settings.poisson_ratio = material.poisson_ratio;
+    if (material.compressive_strength) {
+        settings.compressive_strength = *material.compressive_strength;
+        settings.friction_angle = material.friction_angle * std::numbers::pi / 180;
+        const Vec3& g = model.scene.gravity;
+        settings.down = g.norm() > 0 ? Vec3(g.normalized()) : Vec3::Zero();
+    }
     if (material.tensile_strength_wet) {
         // [D] Water weakens rock and soil (wet sandstone keeps about half its strength; a soil
         // loses the cohesion its suction gave it): the strengths fall linearly with saturation

@@ -148,6 +148,16 @@ Scene parse_scene(const std::string& text) {
         mat.tensile_strength = m["tensile_strength"], mat.fracture_energy = m["fracture_energy"];
         if (m.contains("tensile_strength_wet"))
             mat.tensile_strength_wet = m["tensile_strength_wet"].get<Real>();
+        if (m.contains("compressive_strength")) {
+            mat.compressive_strength = m["compressive_strength"].get<Real>();
+            if (!(*mat.compressive_strength > mat.tensile_strength))
+                throw SceneError(solid.path + "/material/compressive_strength",
+                                 fmt::format("a compressive strength above the tensile strength "
+                                             "({} Pa)",
+                                             mat.tensile_strength),
+                                 m["compressive_strength"].dump());
+        }
+        mat.friction_angle = m["friction_angle"];
         mat.capillary_pressure = m["capillary_pressure"],
         mat.capillary_exponent = m["capillary_exponent"];
         mat.pore_stiffness = m["pore_stiffness"],

@@ -66,6 +66,9 @@ struct PorousMaterial {
     Real tensile_strength{};  ///< sigma_t, Pa
     /// sigma_t of the saturated material (S = 1), Pa; absent: sigma_t at every saturation.
     std::optional<Real> tensile_strength_wet;
+    /// sigma_c of a Mohr-Coulomb shear test (M25), Pa; absent: no shear cracks.
+    std::optional<Real> compressive_strength;
+    Real friction_angle{};       ///< phi of the shear test, degrees
     Real fracture_energy{};      ///< G_c (M26), J/m^2
     Real capillary_pressure{};   ///< k^c, Pa
     Real capillary_exponent{};   ///< alpha

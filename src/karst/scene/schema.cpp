@@ -179,9 +179,19 @@ std::vector<KeySpec> make_schema() {
             "principal stress exceeds it cracks (with /fracture/enabled)."),
         optional("/porous_solids/[]/material/tensile_strength_wet", T::Number, "Pa", positive(1e12),
                  "The tensile strength of the saturated material: water weakens rock and soil, "
-                 "so the strengths (tensile_strength and tensile_strength_across) fall linearly "
+                 "so the strengths (tensile_strength, tensile_strength_across and "
+                 "compressive_strength) fall linearly "
                  "with the saturation S to this one at S = 1 (docs/method.md M25). Absent: no "
                  "weakening."),
+        optional("/porous_solids/[]/material/compressive_strength", T::Number, "Pa", positive(1e12),
+                 "Uniaxial compressive strength sigma_c of a Mohr-Coulomb shear test beside the "
+                 "tensile one (docs/method.md M25): a node whose effective principal stresses "
+                 "reach (s1 - s3) + (s1 + s3) sin phi = sigma_c (1 - sin phi) cracks along the "
+                 "failure plane, at 45 + phi/2 degrees to the plane the largest compression acts "
+                 "on; water weakens it as it does the tensile strength. It must exceed "
+                 "tensile_strength. Absent: no shear cracks."),
+        key("/porous_solids/[]/material/friction_angle", T::Number, "degree", closed(0, 60), 30.0,
+            "Friction angle phi of the Mohr-Coulomb shear test (with compressive_strength)."),
         key("/porous_solids/[]/material/fracture_energy", T::Number, "J/m^2", positive(1e12), 10.0,
             "Critical energy-release rate G_c (M26): a crack's area is the node's strain energy "
             "over G_c (its radius clamped to 0.5-3 spacings)."),
