@@ -15,10 +15,10 @@ namespace karst {
 struct Crack {
     Index node = 0;               ///< the mesh node it starts from
     Vec3 centre = Vec3::Zero();   ///< m
-    Vec3 normal = Vec3::UnitZ();  ///< eigenvector of sigma'_1 (M25)
+    Vec3 normal = Vec3::UnitZ();  ///< eigenvector of sigma'_1, or the shear plane's (M25)
     Real radius = 0;              ///< sqrt(area / pi), clamped to [0.5 dx, 3 dx] (M26), m
     Real area = 0;                ///< U_a / G_c before the clamp (M26), m^2
-    Real stress_ratio = 0;        ///< sigma'_1 / sigma_t
+    Real stress_ratio = 0;        ///< the criterion's ratio (sigma'_1 / sigma_t for Rankine)
 };
 
 struct CrackSettings {
