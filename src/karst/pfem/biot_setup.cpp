@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <array>
-#include <numbers>
 #include <optional>
 
 namespace karst {
@@ -329,7 +328,7 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
         if (material.compressive_strength)
             crack[a] = std::max(
                 crack[a], mohr_coulomb_ratio(stress.principal[a], *material.compressive_strength,
-                                             material.friction_angle * std::numbers::pi / 180));
+                                             material.friction_angle));
     }
     PointSet local;
     local.add_vector("displacement", fields.u);

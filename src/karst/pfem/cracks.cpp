@@ -117,15 +117,18 @@ std::vector<Crack> find_cracks(const TetMesh& mesh, const NodalStress& stress,
                 settings.strength_across;
             if (across > ratio) ratio = across, n = m;
         }
+        bool slips = false;
         if (shear && std::isfinite(s[0])) {
             const Real slip =
                 mohr_coulomb_ratio(s, settings.compressive_strength, settings.friction_angle);
-            if (slip > ratio)
-                ratio = slip, n = mohr_coulomb_normal(stress.effective[a], settings.friction_angle,
-                                                      mesh.nodes[a] - centroid, settings.down);
+            if (slip > ratio) ratio = slip, slips = true;
         }
         if (!settings.strength_scale.empty()) ratio /= settings.strength_scale[a];
         if (!(ratio > 1)) continue;
+        // The shear plane needs all three principal directions: found only for a node that cracks.
+        if (slips)
+            n = mohr_coulomb_normal(stress.effective[a], settings.friction_angle,
+                                    mesh.nodes[a] - centroid, settings.down);
         Crack c;
         c.node = a, c.centre = mesh.nodes[a], c.stress_ratio = ratio;
         // The eigenvector's sign is arbitrary: fix it so that the disk does not depend on the

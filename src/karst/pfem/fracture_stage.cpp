@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 
 namespace karst {
 
@@ -77,7 +76,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     settings.poisson_ratio = material.poisson_ratio;
     if (material.compressive_strength) {
         settings.compressive_strength = *material.compressive_strength;
-        settings.friction_angle = material.friction_angle * std::numbers::pi / 180;
+        settings.friction_angle = material.friction_angle;
         const Vec3& g = model.scene.gravity;
         settings.down = g.norm() > 0 ? Vec3(g.normalized()) : Vec3::Zero();
     }

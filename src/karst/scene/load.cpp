@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <numbers>
 #include <stdexcept>
 #include <sstream>
 
@@ -157,7 +158,7 @@ Scene parse_scene(const std::string& text) {
                                              mat.tensile_strength),
                                  m["compressive_strength"].dump());
         }
-        mat.friction_angle = m["friction_angle"];
+        mat.friction_angle = m["friction_angle"].get<Real>() * std::numbers::pi / 180;
         mat.capillary_pressure = m["capillary_pressure"],
         mat.capillary_exponent = m["capillary_exponent"];
         mat.pore_stiffness = m["pore_stiffness"],

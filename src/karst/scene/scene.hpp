@@ -68,7 +68,7 @@ struct PorousMaterial {
     std::optional<Real> tensile_strength_wet;
     /// sigma_c of a Mohr-Coulomb shear test (M25), Pa; absent: no shear cracks.
     std::optional<Real> compressive_strength;
-    Real friction_angle{};       ///< phi of the shear test, degrees
+    Real friction_angle{};       ///< phi of the shear test, rad (degrees in the scene file)
     Real fracture_energy{};      ///< G_c (M26), J/m^2
     Real capillary_pressure{};   ///< k^c, Pa
     Real capillary_exponent{};   ///< alpha

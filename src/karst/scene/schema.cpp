@@ -180,9 +180,8 @@ std::vector<KeySpec> make_schema() {
         optional("/porous_solids/[]/material/tensile_strength_wet", T::Number, "Pa", positive(1e12),
                  "The tensile strength of the saturated material: water weakens rock and soil, "
                  "so the strengths (tensile_strength, tensile_strength_across and "
-                 "compressive_strength) fall linearly "
-                 "with the saturation S to this one at S = 1 (docs/method.md M25). Absent: no "
-                 "weakening."),
+                 "compressive_strength) fall linearly with the saturation S to this one at "
+                 "S = 1 (docs/method.md M25). Absent: no weakening."),
         optional("/porous_solids/[]/material/compressive_strength", T::Number, "Pa", positive(1e12),
                  "Uniaxial compressive strength sigma_c of a Mohr-Coulomb shear test beside the "
                  "tensile one (docs/method.md M25): a node whose effective principal stresses "
