@@ -4,6 +4,7 @@
 #include "karst/pfem/box_nodes.hpp"
 #include "karst/pfem/cracks.hpp"
 #include "karst/pfem/face_links.hpp"
+#include "karst/core/disjoint_sets.hpp"
 #include "karst/pfem/mesh_split.hpp"
 
 #include <gtest/gtest.h>
@@ -349,6 +350,30 @@ TEST(MeshSplit, SmallPiecesAreSparedUnlessTheyStayAnchored) {
     cut = cut_after_five;
     EXPECT_EQ(spare_small_pieces(n, links, cut, 24, holds_last_tet), 1);
     EXPECT_EQ(cut[4], 0);
+}
+
+// Two pieces of 30 and 35 tets, cut apart, with a crumb of 5 tets between them cut off both: the
+// crumb rejoins the piece it shares the most cut faces with, and the two pieces stay apart. (It
+// rejoined both before, and the crumb bridged the crack: a column cut at its foot hung on it.)
+TEST(MeshSplit, ACrumbBetweenTwoPiecesRejoinsOneAndTheCrackBetweenThemStays) {
+    const Index n = 70;  // A: 0-29, the crumb: 30-34, B: 35-69
+    const auto spared = [&](bool second_face_on_a, Index expect_restored) {
+        std::vector<ElementLink> links;
+        std::vector<char> cut;
+        for (Index e = 0; e + 1 < n; ++e)
+            links.push_back({e, e + 1}), cut.push_back(e == 29 || e == 34);
+        links.push_back({0, 69}), cut.push_back(1);  // A and B touch across the crack
+        if (second_face_on_a) links.push_back({28, 31}), cut.push_back(1);
+        EXPECT_EQ(spare_small_pieces(n, links, cut, 24), expect_restored);
+        DisjointSets pieces(n);
+        for (size_t k = 0; k < links.size(); ++k)
+            if (!cut[k]) pieces.join(links[k].a, links[k].b);
+        EXPECT_NE(pieces.find(0), pieces.find(69)) << "the crack between A and B stays";
+        const Index crumb = pieces.find(32);
+        return crumb == pieces.find(0) ? 'A' : crumb == pieces.find(69) ? 'B' : '-';
+    };
+    EXPECT_EQ(spared(true, 2), 'A') << "two faces on A against one on B";
+    EXPECT_EQ(spared(false, 1), 'B') << "one face on each: the larger piece";
 }
 
 /// A bar 1 x 0.3 x 0.3 m on the lattice, its links, and those a crack disk at x = 0.5 with

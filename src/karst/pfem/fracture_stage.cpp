@@ -242,7 +242,11 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         // velocities only spread a quasi-static call's u over dt_B (sim/energy.cpp counts them
         // no kinetic energy). So a piece cut from it starts at rest; inheriting them gave an
         // arch's pieces more kinetic energy than its weight and elasticity had released.
-        for (Index i : members[c]) p.fragment[i] = f, p.v[i] = Vec3::Zero();
+        // [D] It starts on its undeformed positions, where the fragments' contacts met it
+        // (rigid/fragment_motion.cpp): on X + u it overlapped the fragments that rested on it,
+        // and their springs threw them up with energy no crack had released.
+        for (Index i : members[c])
+            p.fragment[i] = f, p.v[i] = Vec3::Zero(), p.x[i] = st.rest_x[p.id[i]];
         state.porous.fragments.push_back(free_fragment(p, members[c], model.dx));
         ++st.fracture.fragments_created;
     }

@@ -232,16 +232,46 @@ Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
             if (!cut[k]) sets.join(links[k].a, links[k].b);
         std::vector<std::vector<Index>> pieces(tet_count);
         for (Index e = 0; e < tet_count; ++e) pieces[sets.find(e)].push_back(e);
-        // 1: a piece under the resolution, whose cuts are restored.
         std::vector<char> small(tet_count, 0);
         for (Index root = 0; root < tet_count; ++root) {
             const std::vector<Index>& piece = pieces[root];
             small[root] = !piece.empty() && Index(piece.size()) < min_tets &&
                           !(stays_anchored && stays_anchored(piece));
         }
-        for (size_t k = 0; k < links.size(); ++k)
-            if (cut[k] && (small[sets.find(links[k].a)] || small[sets.find(links[k].b)]))
+        // A small piece rejoins the one neighbour it shares the most cut faces with (the larger
+        // on a tie): restoring its cuts to every side rebuilt the bridges that the other cracks
+        // had cut, and a body whose foot a round of cracks crumbled stayed hanging on the crumbs.
+        std::vector<std::vector<std::pair<Index, Index>>> shared(tet_count);  // (neighbour, faces)
+        for (size_t k = 0; k < links.size(); ++k) {
+            if (!cut[k]) continue;
+            const Index a = sets.find(links[k].a), b = sets.find(links[k].b);
+            if (a == b) continue;
+            for (const auto& [from, to] : {std::pair(a, b), std::pair(b, a)}) {
+                if (!small[from]) continue;
+                auto& list = shared[from];
+                auto it = std::find_if(list.begin(), list.end(),
+                                       [to](const auto& entry) { return entry.first == to; });
+                if (it == list.end())
+                    list.push_back({to, 1});
+                else
+                    ++it->second;
+            }
+        }
+        std::vector<Index> partner(tet_count, -1);
+        for (Index root = 0; root < tet_count; ++root) {
+            std::pair<Index, Index> best{-1, 0};
+            for (const auto& [to, faces] : shared[root])
+                if (faces > best.second ||
+                    (faces == best.second && pieces[to].size() > pieces[best.first].size()))
+                    best = {to, faces};
+            partner[root] = best.first;
+        }
+        for (size_t k = 0; k < links.size(); ++k) {
+            if (!cut[k]) continue;
+            const Index a = sets.find(links[k].a), b = sets.find(links[k].b);
+            if (a != b && (partner[a] == b || partner[b] == a))
                 cut[k] = 0, ++restored, changed = true;
+        }
     }
     return restored;
 }

@@ -40,11 +40,12 @@ std::vector<Index> tet_components(Index tet_count, std::span<const ElementLink> 
 Index cut_sliver_bridges(const TetMesh& mesh, std::span<const ElementLink> links,
                          std::vector<char>& cut, Real min_volume);
 
-/// Restores cut links around every piece of fewer than `min_tets` tets that the cuts would make,
-/// until none is left: a crack does not chip off pieces below the mesh's resolution (they would
-/// be rigid fragments of a few particles). A small piece for which `stays_anchored(its tets)`
-/// holds becomes no fragment and is left cut, so that a body hanging from a small anchored stub
-/// can break off it. Returns the number of links restored.
+/// Joins every piece of fewer than `min_tets` tets that the cuts would make to the neighbour it
+/// shares the most cut faces with (restoring those cuts), until none is left: a crack does not
+/// chip off pieces below the mesh's resolution (they would be rigid fragments of a few
+/// particles), and the cuts between the larger pieces stay. A small piece for which
+/// `stays_anchored(its tets)` holds becomes no fragment and is left cut, so that a body hanging
+/// from a small anchored stub can break off it. Returns the number of links restored.
 Index spare_small_pieces(Index tet_count, std::span<const ElementLink> links,
                          std::vector<char>& cut, Index min_tets,
                          const std::function<bool(std::span<const Index>)>& stays_anchored = {});
