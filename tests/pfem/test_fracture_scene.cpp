@@ -471,7 +471,8 @@ TEST(FractureScene, ABarUnderARampedCompressionSlipsAtItsCompressiveStrengthOnTh
 TEST(FractureScene, WaterWeakensTheBarLinearlyWithItsSaturationToItsWetStrength) {
     // The ramp of the test above on bars at S = 1 and S = 0.5 with a wet strength half the dry
     // one: they crack at 0.5 and 0.75 of the dry strength. The bars are stiff, so that their
-    // stretch hardly lowers S (at E = 1 MPa the stretched pores held 10 % less).
+    // stretch hardly lowers S (at E = 1 MPa the stretched pores held 10 % less). At 0.9 of that
+    // load the mesh frames' crack_candidate reads 0.9, the ratio to the wet strength.
     const std::string ramp = R"(
       { "kind": "drained", "region": { "type": "box", "min": [-1, -1, -1], "max": [2, 2, 2] } },
       { "kind": "traction", "traction": [-1e5, 0, 0], "table": [[0, 0], [2, 2]],
@@ -484,6 +485,16 @@ TEST(FractureScene, WaterWeakensTheBarLinearlyWithItsSaturationToItsWetStrength)
             fmt::format(R"(, "tensile_strength_wet": 5e4, "initial_saturation": {})", saturation),
             1e8));
         const Real expected = 1 - 0.5 * saturation;
+        sim.run_until(0.9 * expected);
+        ASSERT_TRUE(sim.state.structures.cracks.empty()) << "S = " << saturation;
+        MeshFrame frame;
+        append_structure_meshes(sim.model, sim.state, frame);
+        const auto candidate =
+            std::find_if(frame.nodes.arrays.begin(), frame.nodes.arrays.end(),
+                         [](const auto& a) { return a.name == "crack_candidate"; });
+        ASSERT_NE(candidate, frame.nodes.arrays.end());
+        const Real largest = *std::max_element(candidate->values.begin(), candidate->values.end());
+        EXPECT_NEAR(largest, 0.9, 0.05) << "S = " << saturation;
         const Real t = first_crack_time(sim, 2);
         ASSERT_GT(t, 0) << "S = " << saturation;
         EXPECT_GE(t, 0.95 * expected) << "S = " << saturation;

@@ -311,7 +311,8 @@ void append_arrays(PointSet& into, const PointSet& local) {
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
                        const BiotFields& fields, const BiotFields& carried,
                        const std::vector<Vec3>& support_force, const PorousMaterial& material,
-                       const std::vector<Mat3>& node_tensors, bool feedback) {
+                       const std::vector<Mat3>& node_tensors, bool feedback,
+                       std::span<const Real> strength_scale) {
     const Index offset = Index(frame.nodes.x.size());
     const Index n = mesh.node_count();
     const NodalStress stress = nodal_stress(mesh, problem.material, carried);
@@ -329,6 +330,7 @@ void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem&
             crack[a] = std::max(
                 crack[a], mohr_coulomb_ratio(stress.principal[a], *material.compressive_strength,
                                              material.friction_angle));
+        if (!strength_scale.empty()) crack[a] /= strength_scale[a];
     }
     PointSet local;
     local.add_vector("displacement", fields.u);

@@ -96,14 +96,16 @@ void refresh_mobility(BiotSolver& solver, const TetMesh& mesh, const PorousMater
 /// displacement, pore_pressure, porosity and permeability (6 components) as the pores use them
 /// (the call's M23 and M24 with `feedback`, else the rest values phi0 and K0), effective_stress
 /// (6), principal_stress (3), crack_candidate (sigma'_1 / sigma_t, M25, or the Mohr-Coulomb
-/// ratio where that is larger and the material has a compressive strength) and support_force (3,
+/// ratio where that is larger and the material has a compressive strength, both over the
+/// strengths times `strength_scale` where given: the water's weakening) and support_force (3,
 /// zero where `support_force` does not cover the mesh: no call on it yet). The stresses are
 /// those of `carried` (the fields with u from the unloaded mesh, fields_with_weight), the rest
 /// those of `fields`.
 void append_mesh_frame(MeshFrame& frame, const TetMesh& mesh, const BiotProblem& problem,
                        const BiotFields& fields, const BiotFields& carried,
                        const std::vector<Vec3>& support_force, const PorousMaterial& material,
-                       const std::vector<Mat3>& node_tensors, bool feedback);
+                       const std::vector<Mat3>& node_tensors, bool feedback,
+                       std::span<const Real> strength_scale);
 
 /// Appends the arrays of `local` to those of `into` (by name), creating them for the first solid.
 void append_arrays(PointSet& into, const PointSet& local);

@@ -80,19 +80,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         const Vec3& g = model.scene.gravity;
         settings.down = g.norm() > 0 ? Vec3(g.normalized()) : Vec3::Zero();
     }
-    if (material.tensile_strength_wet) {
-        // [D] Water weakens rock and soil (wet sandstone keeps about half its strength; a soil
-        // loses the cohesion its suction gave it): the strengths fall linearly with saturation
-        // to the wet one at S = 1.
-        const Real wet = *material.tensile_strength_wet / material.tensile_strength;
-        const PoreWaterLaw& law = model.pore_laws[s.solid];
-        settings.strength_scale.assign(s.mesh.node_count(), 1);
-        for (Index a = 0; a < s.mesh.node_count(); ++a)
-            if (const Index i = index_of[s.node_id[a]]; i >= 0)
-                settings.strength_scale[a] =
-                    1 + (wet - 1) * std::min<Real>(1, law.saturation(p.absorbed_mass[i],
-                                                                     p.porosity[i], p.volume[i]));
-    }
+    settings.strength_scale = strength_scale(model, state, s);
     if (material.strength_across) {
         settings.strength_across = *material.strength_across;
         settings.layer_normal = layer_normals(s.node_tensors, material.layering_ratio);
@@ -291,6 +279,25 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
 }
 
 }  // namespace
+
+std::vector<Real> strength_scale(const Model& model, const State& state, const Structure& s) {
+    const PorousMaterial& material = model.scene.porous_solids[s.solid].material;
+    if (!material.tensile_strength_wet) return {};
+    // [D] Water weakens rock and soil (wet sandstone keeps about half its strength; a soil loses
+    // the cohesion its suction gave it): the strengths fall linearly with saturation to the wet
+    // one at S = 1.
+    const PorousParticles& p = state.porous.particles;
+    const std::vector<Index> index_of = index_by_id(p, state.structures.node_of.size());
+    const Real wet = *material.tensile_strength_wet / material.tensile_strength;
+    const PoreWaterLaw& law = model.pore_laws[s.solid];
+    std::vector<Real> scale(s.mesh.node_count(), 1);
+    for (Index a = 0; a < s.mesh.node_count(); ++a)
+        if (const Index i = index_of[s.node_id[a]]; i >= 0)
+            scale[a] =
+                1 + (wet - 1) * std::min<Real>(1, law.saturation(p.absorbed_mass[i], p.porosity[i],
+                                                                 p.volume[i]));
+    return scale;
+}
 
 bool fracture_structures(const Model& model, State& state, Real time) {
     if (!model.scene.fracture.enabled) return false;

@@ -12,6 +12,10 @@ namespace karst {
 /// particles or fragments): the pore-flow pairs are then stale.
 bool fracture_structures(const Model& model, State& state, Real time);
 
+/// Per node of structure `s`, the factor on its material's strengths from its saturation (the
+/// wet strength at S = 1); empty when the material has no wet strength.
+std::vector<Real> strength_scale(const Model& model, const State& state, const Structure& s);
+
 /// Whether some fragment moves (free, with mass): a poroelastic-only run then needs the CFL step.
 bool any_free_fragment(const State& state);
 

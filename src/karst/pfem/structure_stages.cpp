@@ -3,6 +3,7 @@
 #include "karst/core/parallel.hpp"
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/face_links.hpp"
+#include "karst/pfem/fracture_stage.hpp"
 #include "karst/pfem/mesh_split.hpp"
 #include "karst/scene/wall_crossing.hpp"
 
@@ -413,7 +414,8 @@ void append_structure_meshes(const Model& model, State& state, MeshFrame& frame)
         append_mesh_frame(frame, s.mesh, solver_of(model, state, slot).problem(), s.fields,
                           fields_with_weight(state.structures, s), s.support_force,
                           model.scene.porous_solids[s.solid].material, s.node_tensors,
-                          model.scene.poroelastic.permeability_feedback);
+                          model.scene.poroelastic.permeability_feedback,
+                          strength_scale(model, state, s));
     }
 }
 
