@@ -363,7 +363,8 @@ std::string column(Real compressive_strength) {
 // A column too weak for its weight in shear fails at its foot along inclined planes (Mohr-Coulomb
 // at phi = 30 degrees: normals 60 degrees off the vertical), and pieces come off it without
 // gaining energy. Rankine alone sees no tension in it, and a column twice as strong as its foot's
-// stress stands. Only the first round's cracks are read: later ones answer the cut foot.
+// stress stands. Only the first round's planes are checked (later ones answer the cut foot);
+// every crack must lie above the floor, and the cut column must come free.
 TEST(FractureScene, AColumnWeakerThanItsWeightInShearSlipsAtItsFootAlongInclinedPlanes) {
     test::Simulation weak(column(5e3));
     ASSERT_TRUE(weak.model.poroelastic_only());
