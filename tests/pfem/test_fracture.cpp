@@ -1,10 +1,10 @@
 // Fracture (issue 13, docs/method.md §5.5-5.6): the Rankine test on the effective stress of solved
 // Biot problems (tension, shear, compression, pore pressure alone), and node splitting along
 // broken links.
+#include "karst/core/disjoint_sets.hpp"
 #include "karst/pfem/box_nodes.hpp"
 #include "karst/pfem/cracks.hpp"
 #include "karst/pfem/face_links.hpp"
-#include "karst/core/disjoint_sets.hpp"
 #include "karst/pfem/mesh_split.hpp"
 
 #include <gtest/gtest.h>

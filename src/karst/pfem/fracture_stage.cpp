@@ -80,7 +80,7 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         const Vec3& g = model.scene.gravity;
         settings.down = g.norm() > 0 ? Vec3(g.normalized()) : Vec3::Zero();
     }
-    settings.strength_scale = strength_scale(model, state, s);
+    settings.strength_scale = strength_scale(model, state, s, index_of);
     if (material.strength_across) {
         settings.strength_across = *material.strength_across;
         settings.layer_normal = layer_normals(s.node_tensors, material.layering_ratio);
@@ -280,14 +280,14 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
 
 }  // namespace
 
-std::vector<Real> strength_scale(const Model& model, const State& state, const Structure& s) {
+std::vector<Real> strength_scale(const Model& model, const State& state, const Structure& s,
+                                 std::span<const Index> index_of) {
     const PorousMaterial& material = model.scene.porous_solids[s.solid].material;
     if (!material.tensile_strength_wet) return {};
     // [D] Water weakens rock and soil (wet sandstone keeps about half its strength; a soil loses
     // the cohesion its suction gave it): the strengths fall linearly with saturation to the wet
     // one at S = 1.
     const PorousParticles& p = state.porous.particles;
-    const std::vector<Index> index_of = index_by_id(p, state.structures.node_of.size());
     const Real wet = *material.tensile_strength_wet / material.tensile_strength;
     const PoreWaterLaw& law = model.pore_laws[s.solid];
     std::vector<Real> scale(s.mesh.node_count(), 1);

@@ -6,6 +6,9 @@
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 
+#include <span>
+#include <vector>
+
 namespace karst {
 
 /// Cracks made at `time` are recorded with it. Returns true when some structure changed (new
@@ -13,8 +16,10 @@ namespace karst {
 bool fracture_structures(const Model& model, State& state, Real time);
 
 /// Per node of structure `s`, the factor on its material's strengths from its saturation (the
-/// wet strength at S = 1); empty when the material has no wet strength.
-std::vector<Real> strength_scale(const Model& model, const State& state, const Structure& s);
+/// wet strength at S = 1); empty when the material has no wet strength. `index_of` maps a
+/// particle id to its index (index_by_id).
+std::vector<Real> strength_scale(const Model& model, const State& state, const Structure& s,
+                                 std::span<const Index> index_of);
 
 /// Whether some fragment moves (free, with mass): a poroelastic-only run then needs the CFL step.
 bool any_free_fragment(const State& state);

@@ -409,13 +409,15 @@ bool feed_back_structures(const Model& model, State& state) {
 }
 
 void append_structure_meshes(const Model& model, State& state, MeshFrame& frame) {
+    const std::vector<Index> index_of =
+        index_by_id(state.porous.particles, state.structures.node_of.size());
     for (size_t slot = 0; slot < state.structures.structures.size(); ++slot) {
         const Structure& s = state.structures.structures[slot];
         append_mesh_frame(frame, s.mesh, solver_of(model, state, slot).problem(), s.fields,
                           fields_with_weight(state.structures, s), s.support_force,
                           model.scene.porous_solids[s.solid].material, s.node_tensors,
                           model.scene.poroelastic.permeability_feedback,
-                          strength_scale(model, state, s));
+                          strength_scale(model, state, s, index_of));
     }
 }
 
