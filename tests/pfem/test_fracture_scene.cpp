@@ -369,9 +369,11 @@ TEST(FractureScene, AColumnWeakerThanItsWeightInShearSlipsAtItsFootAlongInclined
     test::Simulation weak(column(5e3));
     ASSERT_TRUE(weak.model.poroelastic_only());
     const Real e0 = total_mechanical_energy(weak);
-    Real highest = e0, largest_u = 0;
+    Real highest = e0, lowest = e0, largest_gain = 0, largest_u = 0;
     weak.run_until(0.5, [&] {
-        highest = std::max(highest, total_mechanical_energy(weak));
+        const Real e = total_mechanical_energy(weak);
+        highest = std::max(highest, e), largest_gain = std::max(largest_gain, e - lowest);
+        lowest = std::min(lowest, e);
         for (const Structure& s : weak.state.structures.structures)
             for (const Vec3& u : s.fields.u) largest_u = std::max(largest_u, u.norm());
     });
@@ -387,6 +389,10 @@ TEST(FractureScene, AColumnWeakerThanItsWeightInShearSlipsAtItsFootAlongInclined
     EXPECT_GE(inclined, 7) << "of 8 inclined";
     EXPECT_GE(st.fracture.fragments_created, 1);
     EXPECT_LT(highest, e0 + 0.02 * (e0 - total_mechanical_energy(weak))) << "J";
+    // Nor after it falls: the contact springs count in the total, and a split loads none of them
+    // (the split's offsets left pairs across the cut at 0.85-0.94 dx, whose springs held 1 J the
+    // moment the column came free).
+    EXPECT_LT(largest_gain, 0.02 * (e0 - lowest)) << "J over the running minimum";
     // Cut at its foot, the column comes down as a free piece. (It hung on crumbs of the cut foot
     // before, a near-mechanism whose linear solve moved its top by 2.3 m, with crack centres
     // 0.25 m under the floor.)
@@ -568,8 +574,10 @@ TEST(FractureScene, TheShippedCollapsingSceneBreaksIntoFragmentsWithoutGainingEn
     Real highest = e0;
     sim.run_until(sim.model.scene.time.end - 1e-9,
                   [&] { highest = std::max(highest, total_mechanical_energy(sim)); });
-    EXPECT_GE(sim.state.structures.fracture.fragments_created, 2);
-    EXPECT_LT(highest, e0 * 1.001) << "kinetic + potential energy rose";
+    // The wall's foot is cut off as a free slab. (A second piece, a corner crumb, came off while
+    // the split loaded the contact springs, whose kicks reached the wall's Biot loads.)
+    EXPECT_GE(sim.state.structures.fracture.fragments_created, 1);
+    EXPECT_LT(highest, e0 * 1.001) << "the total energy rose";
 }
 
 // Fig. 9 at its size: the water poured on the block soaks its foot from the pool, saturated
@@ -583,7 +591,7 @@ TEST(FractureScene, TheShippedSoakedBlockSpallsSaturatedPiecesWithoutGainingEner
     Real highest = e0;
     sim.run_until(sim.model.scene.time.end - 1e-9,
                   [&] { highest = std::max(highest, total_mechanical_energy(sim)); });
-    EXPECT_LT(highest, e0 * 1.001) << "kinetic + potential energy rose";
+    EXPECT_LT(highest, e0 * 1.001) << "the total energy rose";
     const PorousParticles& p = sim.state.porous.particles;
     EXPECT_GT(totals(p).water - water0, 5.0) << "kg soaked in";
     const PoreWaterLaw& law = sim.model.pore_laws[0];

@@ -50,5 +50,78 @@ TEST(Contact, NoForceWithinOneFragment) {
     EXPECT_EQ(force[0], Vec3::Zero());
 }
 
+TEST(Contact, APairACrackLeftShortPushesOnlyWhenItClosesFurther) {
+    const Real dx = 0.02;
+    Collision c(0.9 * dx, 0.0, 1);
+    c.p.id = {10, 11};
+    const ContactLaw law = ContactLaw::for_fragments(dx, 1.0, 9.81, c.m, 0.2);
+    // One body (both flagged) that a crack split into fragments 0 and 1 at 0.9 dx.
+    std::vector<CrackContact> cracked;
+    const std::vector<char> both{1, 1};
+    const std::vector<Vec3> before{Vec3(0, 0, 0), Vec3(dx, 0, 0)};
+    rest_after_split(cracked, c.p, both, before, c.p.x, c.p.id, dx);
+    ASSERT_EQ(cracked.size(), 1u);
+    EXPECT_EQ(cracked[0].lo, 10);
+    EXPECT_EQ(cracked[0].hi, 11);
+    EXPECT_NEAR(cracked[0].rest, 0.9 * dx, 1e-15);
+    const auto force_at = [&](Real gap) {
+        c.p.x[1] = Vec3(gap, 0, 0);
+        std::vector<Vec3> force(2, Vec3::Zero());
+        add_contact_forces(c.p, c.pairs, law, force, {}, cracked);
+        return force[1][0];
+    };
+    EXPECT_EQ(force_at(0.9 * dx), 0) << "the spring starts unloaded where the crack left it";
+    EXPECT_EQ(force_at(0.95 * dx), 0) << "and does not pull the pieces together";
+    EXPECT_NEAR(force_at(0.85 * dx), law.stiffness * 0.05 * dx, 1e-9 * law.stiffness * dx);
+    std::vector<Vec3> force(2, Vec3::Zero());
+    c.p.x[1] = Vec3(0.85 * dx, 0, 0);
+    add_contact_forces(c.p, c.pairs, law, force);
+    EXPECT_NEAR(force[1][0], law.stiffness * 0.15 * dx, 1e-9 * law.stiffness * dx)
+        << "without the entry, the law's d0";
+
+    std::vector<CrackContact> kept = cracked;
+    c.p.x[1] = Vec3(0.99 * dx, 0, 0);
+    forget_parted_pairs(kept, c.p, c.p.x, dx);
+    EXPECT_EQ(kept.size(), 1u) << "kept until the pair parts by d0";
+    c.p.x[1] = Vec3(dx, 0, 0);
+    forget_parted_pairs(kept, c.p, c.p.x, dx);
+    EXPECT_TRUE(kept.empty()) << "then the law's d0 holds again";
+    kept = cracked;
+    c.p.fragment[1] = 0;
+    forget_parted_pairs(kept, c.p, c.p.x, dx);
+    EXPECT_TRUE(kept.empty()) << "a pair merged into one fragment is forgotten";
+}
+
+TEST(Contact, ASplitKeepsTheLoadOfASpringAgainstAnotherFragment) {
+    const Real dx = 0.02;
+    // Particle 0 belongs to the body the crack split; particle 1 is a fragment resting on it,
+    // sunk 0.05 dx. The split's offset moved particle 0 another 0.05 dx closer.
+    Collision c(0.9 * dx, 0.0, 1);
+    c.p.id = {3, 4};
+    const std::vector<char> body{1, 0};
+    const std::vector<Vec3> before{Vec3(-0.05 * dx, 0, 0), Vec3(0.9 * dx, 0, 0)};
+    std::vector<CrackContact> pairs;
+    rest_after_split(pairs, c.p, body, before, c.p.x, c.p.id, dx);
+    ASSERT_EQ(pairs.size(), 1u);
+    EXPECT_NEAR(pairs[0].rest, 0.95 * dx, 1e-15) << "the same 0.05 dx of load, none added";
+    rest_after_split(pairs, c.p, body, c.p.x, c.p.x, c.p.id, dx);
+    EXPECT_NEAR(pairs[0].rest, 0.95 * dx, 1e-15) << "a split that did not move it keeps it";
+
+    c.p.id = {5, 4};  // particle 0 is now a copy of id 3, split off where its parent was
+    const std::vector<Index> was{3, 4};
+    rest_after_split(pairs, c.p, body, c.p.x, c.p.x, was, dx);
+    ASSERT_EQ(pairs.size(), 2u);
+    EXPECT_NEAR(pair_rest_distance(pairs, 5, 4, dx), 0.95 * dx, 1e-15) << "the parent's rest";
+    c.p.id = {3, 4};
+
+    std::vector<CrackContact> none;
+    const std::vector<Vec3> apart{Vec3(0.1 * dx, 0, 0), Vec3(0.9 * dx, 0, 0)};
+    rest_after_split(none, c.p, body, apart, c.p.x, c.p.id, dx);
+    EXPECT_TRUE(none.empty()) << "a split that moved it away leaves the law's d0";
+    c.p.origin = {3, 3};
+    rest_after_split(none, c.p, std::vector<char>{1, 1}, c.p.x, c.p.x, c.p.id, dx);
+    EXPECT_TRUE(none.empty()) << "no spring between halves of one split particle";
+}
+
 }  // namespace
 }  // namespace karst

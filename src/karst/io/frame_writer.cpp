@@ -122,14 +122,14 @@ void FrameWriter::write_frame(const FrameParts& parts, const FrameLog& log) {
     }
     std::string csv =
         "frame,time,dt,steps,particles,removed,density_error,mipps,speed_p99,max_speed,kinetic_"
-        "energy,potential_energy,total_energy\n";
+        "energy,potential_energy,contact_energy,total_energy\n";
     for (int f = 0; f < frames(); ++f) {
         const FrameLog& r = rows[f];
         csv += fmt::format(
-            "{},{:.9g},{:.6g},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g}\n", f,
-            r.time, r.dt, r.steps, r.particles, r.removed, r.density_error, r.mipps, r.speed_p99,
-            r.max_speed, r.kinetic_energy, r.potential_energy,
-            r.kinetic_energy + r.potential_energy);
+            "{},{:.9g},{:.6g},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.9g}\n",
+            f, r.time, r.dt, r.steps, r.particles, r.removed, r.density_error, r.mipps, r.speed_p99,
+            r.max_speed, r.kinetic_energy, r.potential_energy, r.contact_energy,
+            r.kinetic_energy + r.potential_energy + r.contact_energy);
     }
     m_folder.write("log.csv", csv);
     if (std::any_of(rows.begin(), rows.end(),

@@ -39,6 +39,7 @@ struct FrameLog {
     Real mipps = 0;             ///< million particle-steps per second since the last frame
     Real kinetic_energy = 0;    ///< fluid + porous particles, J (sim/energy.hpp)
     Real potential_energy = 0;  ///< -sum m g.x, J
+    Real contact_energy = 0;    ///< the fragments' contact springs, J
     Index removed = 0;          ///< fluid particles that left the domain so far
     Real speed_p99 = 0;         ///< 99th percentile of the fluid particles' speed, m/s
     Real max_speed = 0;         ///< fastest fluid particle, m/s

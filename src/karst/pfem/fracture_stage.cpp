@@ -275,6 +275,18 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     for (size_t e = 0; e < tet_of.size(); ++e) next.well_shaped[e] = s.well_shaped[tet_of[e]];
     next.mesh = std::move(mesh);
     s = std::move(next);
+
+    // The contact springs across what this call split take none of its offsets' load
+    // (rigid/contact.hpp): neither between its pieces nor against the fragments around them.
+    const std::vector<Vec3> after = contact_positions(state);
+    std::vector<Vec3> before = after;
+    std::vector<char> in_split(p.size(), 0);
+    std::vector<Index> was = p.id;
+    for (Index k = 0; k < n_new; ++k)
+        if (const Index i = particle[node_id[k]]; i >= 0)
+            in_split[i] = 1, before[i] = rest_before[split.source[k]],
+            was[i] = node_id[split.source[k]];
+    rest_after_split(state.porous.crack_contacts, p, in_split, before, after, was, model.dx);
     return true;
 }
 

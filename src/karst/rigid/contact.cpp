@@ -19,9 +19,71 @@ ContactLaw ContactLaw::for_fragments(Real spacing, Real fragment_mass, Real grav
     return law;
 }
 
+Real pair_rest_distance(std::span<const CrackContact> sorted, Index a, Index b, Real d0) {
+    const CrackContact key{std::min(a, b), std::max(a, b), 0};
+    const auto it = std::lower_bound(sorted.begin(), sorted.end(), key);
+    return it != sorted.end() && it->lo == key.lo && it->hi == key.hi ? it->rest : d0;
+}
+
+void rest_after_split(std::vector<CrackContact>& pairs, const PorousParticles& p,
+                      std::span<const char> split, std::span<const Vec3> before,
+                      std::span<const Vec3> after, std::span<const Index> was, Real d0) {
+    const auto first = std::find(split.begin(), split.end(), 1);
+    if (first == split.end()) return;
+    // The particles within d0 of the body's box, in a grid of cell d0.
+    Aabb box{after[first - split.begin()], after[first - split.begin()]};
+    for (Index i = 0; i < p.size(); ++i)
+        if (split[i]) box.extend(after[i]);
+    box = box.padded(d0);
+    std::vector<Index> near;
+    std::vector<Vec3> near_x;
+    for (Index i = 0; i < p.size(); ++i)
+        if (box.contains(after[i])) near.push_back(i), near_x.push_back(after[i]);
+    const UniformGrid grid(box, d0);
+    CellRanges cells;
+    sort_into_cells(grid, near_x, cells);
+    std::vector<CrackContact> fresh;
+    for (Index i = 0; i < p.size(); ++i) {
+        if (!split[i]) continue;
+        for_each_within(grid, cells, after[i], [&](Index k, const Vec3& xj) {
+            const Index j = near[size_t(k)];
+            if (p.fragment[i] == p.fragment[j] || p.origin[i] == p.origin[j]) return;
+            if (split[j] && p.id[j] < p.id[i]) return;  // each pair of the body once
+            const Real r = (xj - after[i]).norm();
+            Real rest = r;
+            if (!split[j]) {
+                const Real closed = (before[j] - before[i]).norm() - r;
+                rest = pair_rest_distance(pairs, was[i], p.id[j], d0) - std::max(closed, Real(0));
+                if (rest >= d0) return;
+            }
+            fresh.push_back({std::min(p.id[i], p.id[j]), std::max(p.id[i], p.id[j]), rest});
+        });
+    }
+    std::sort(fresh.begin(), fresh.end());
+    std::vector<CrackContact> merged;
+    merged.reserve(pairs.size() + fresh.size());
+    std::set_union(fresh.begin(), fresh.end(), pairs.begin(), pairs.end(),
+                   std::back_inserter(merged));  // equal keys: the fresh entry
+    pairs = std::move(merged);
+}
+
+void forget_parted_pairs(std::vector<CrackContact>& pairs, const PorousParticles& p,
+                         std::span<const Vec3> x, Real d0) {
+    if (pairs.empty()) return;
+    Index top = 0;
+    for (Index id : p.id) top = std::max(top, id);
+    std::vector<Index> index_of(size_t(top) + 1, -1);
+    for (Index k = 0; k < p.size(); ++k) index_of[size_t(p.id[k])] = k;
+    const auto at = [&](Index id) { return id <= top ? index_of[size_t(id)] : Index(-1); };
+    std::erase_if(pairs, [&](const CrackContact& c) {
+        const Index i = at(c.lo), j = at(c.hi);
+        return i < 0 || j < 0 || p.fragment[i] == p.fragment[j] || (x[i] - x[j]).norm() >= d0;
+    });
+}
+
 Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbours,
                          const ContactLaw& law, std::vector<Vec3>& force,
-                         std::span<const Vec3> still_x) {
+                         std::span<const Vec3> still_x, std::span<const CrackContact> cracked) {
     const bool still = !still_x.empty() && !law.scale.empty();
     const auto at = [&](Index k) {
         return still && law.scale[size_t(p.fragment[k])] == 0 ? still_x[k] : p.x[k];
@@ -38,8 +100,13 @@ Index add_contact_forces(const PorousParticles& p, const NeighbourLists& neighbo
             const Index lo = std::min(i, j), hi = std::max(i, j);
             const Vec3 x = at(lo) - at(hi);
             const Real scale = law.pair_scale(p.fragment[i], p.fragment[j]);
-            if (const Real r = x.norm(); r >= law.rest_distance || r == 0 || scale == 0) return;
-            const Vec3 on_lo = law.force(x, velocity(lo) - velocity(hi), scale);
+            const Real r = x.norm();
+            if (r >= law.rest_distance || r == 0 || scale == 0) return;
+            const Real rest =
+                cracked.empty() ? law.rest_distance
+                                : pair_rest_distance(cracked, p.id[i], p.id[j], law.rest_distance);
+            if (r >= rest) return;
+            const Vec3 on_lo = law.force(x, velocity(lo) - velocity(hi), scale, rest);
             sum += i == lo ? on_lo : Vec3(-on_lo);
             ++touching[i];
         });

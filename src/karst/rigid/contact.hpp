@@ -33,21 +33,57 @@ struct ContactLaw {
         return sa == 0 ? sb : sb == 0 ? sa : std::min(sa, sb);
     }
     /// The spring on particle a from b at offset x = x_a - x_b with relative velocity
-    /// v = v_a - v_b (N), for 0 < |x| < d0, times the pair's factor s.
-    Vec3 force(const Vec3& x, const Vec3& v, Real s = 1) const {
+    /// v = v_a - v_b (N), for 0 < |x| < rest, times the pair's factor s.
+    Vec3 force(const Vec3& x, const Vec3& v, Real s, Real rest) const {
         const Real r = x.norm();
         const Vec3 n = x / r;
-        return (s * (stiffness * (rest_distance - r) - damping * v.dot(n))) * n;
+        return (s * (stiffness * (rest - r) - damping * v.dot(n))) * n;
+    }
+    Vec3 force(const Vec3& x, const Vec3& v, Real s = 1) const {
+        return force(x, v, s, rest_distance);
     }
 };
 
+/// A pair of porous particles, by id (lo < hi), that a crack left closer than d0, and the rest
+/// length of its spring: the distance the crack left them at. M27's offsets can bring lattice
+/// neighbours across a crack closer than d0; with the law's d0 their springs would throw the
+/// pieces apart with energy no crack released. The rest length holds until the pair parts by d0.
+struct CrackContact {
+    Index lo = 0, hi = 0;
+    Real rest = 0;
+    friend bool operator<(const CrackContact& a, const CrackContact& b) {
+        return a.lo != b.lo ? a.lo < b.lo : a.hi < b.hi;
+    }
+};
+
+/// The rest length of the pair of particle ids a and b: its entry's in `sorted` (ordered by
+/// (lo, hi)), else d0.
+Real pair_rest_distance(std::span<const CrackContact> sorted, Index a, Index b, Real d0);
+
+/// The rest lengths after a crack moved the particles of one body apart (M27). `split` flags
+/// the body's particles (one fragment before the crack), `before` and `after` are every
+/// particle's contact positions around the split (the others did not move), `was` the id each
+/// particle had before it (a copy's parent's). A pair of the body that the crack put in
+/// different fragments starts unloaded: its rest is its distance. A pair between the body and
+/// another fragment keeps the load it had (a copy, its parent's) and takes none from the split:
+/// its rest shortens by what the split closed it. Entries made here replace older ones.
+void rest_after_split(std::vector<CrackContact>& pairs, const PorousParticles& particles,
+                      std::span<const char> split, std::span<const Vec3> before,
+                      std::span<const Vec3> after, std::span<const Index> was, Real d0);
+
+/// Forgets the pairs that parted by d0 at positions `x` (one per particle), that now share a
+/// fragment, or whose particles are gone.
+void forget_parted_pairs(std::vector<CrackContact>& pairs, const PorousParticles& particles,
+                         std::span<const Vec3> x, Real d0);
+
 /// Adds the contact forces (N) into `force` (one per particle); `neighbours` lists particles
 /// within at least d0 (any fragment). Where `still_x` is given (one per particle), a particle of a
-/// fragment that does not move (scale 0) meets the others at still_x, at rest. Returns the
-/// number of touching pairs.
+/// fragment that does not move (scale 0) meets the others at still_x, at rest. A pair listed in
+/// `cracked` (sorted) takes its rest length there. Returns the number of touching pairs.
 Index add_contact_forces(const PorousParticles& particles, const NeighbourLists& neighbours,
                          const ContactLaw& law, std::vector<Vec3>& force,
-                         std::span<const Vec3> still_x = {});
+                         std::span<const Vec3> still_x = {},
+                         std::span<const CrackContact> cracked = {});
 
 /// The same springs against static wall particles at `wall_x` (the walls take no reaction);
 /// `walls` lists, per porous particle, wall particles within at least d0. Returns the touching

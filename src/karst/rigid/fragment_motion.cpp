@@ -135,24 +135,6 @@ void move_fragments(const Model& model, State& state, const std::vector<Vec3>& f
     });
 }
 
-/// [D] Where a free fragment meets an anchored structure: the structure's undeformed surface
-/// (rest_x), at rest, as linear elasticity poses its loads on the undeformed body. A contact that
-/// followed u fed the spring's answer to u back into the next Biot call's loads, which rang a
-/// nearly cut-off part of a cracked body up by decimetres within three calls; and a surface that
-/// moved with u did work on the fragments resting on it (followed up to 0.1 dx, the collapsing
-/// demo gained 12 % of the energy it had released).
-std::vector<Vec3> undeformed_positions(const State& state) {
-    const PorousParticles& p = state.porous.particles;
-    const StructureState& st = state.structures;
-    std::vector<Vec3> x = p.x;
-    if (st.empty()) return x;
-    parallel_for(p.size(), [&](Index k) {
-        const Index id = p.id[k];
-        if (size_t(id) < st.node_of.size() && st.node_of[id].first >= 0) x[k] = st.rest_x[id];
-    });
-    return x;
-}
-
 }  // namespace
 
 void advance_fragments(const Model& model, State& state, Real dt) {
@@ -171,17 +153,20 @@ void advance_fragments(const Model& model, State& state, Real dt) {
             omega > 0 ? std::max(1, int(std::ceil(dt / contact_sub_step(omega, law) - 1e-9))) : 1;
         const Real h = dt / substeps;
         const std::vector<Vec3> fluid = s.force;
-        const std::vector<Vec3> still_x = undeformed_positions(state);
+        const std::vector<Vec3> still_x = contact_positions(state);
         std::vector<Vec3> force(p.size()), mean(p.size(), Vec3::Zero());
         for (int sub = 0; sub < substeps; ++sub) {
             force = fluid;
-            Index touching = add_contact_forces(p, s.porous_porous, law, force, still_x);
+            Index touching = add_contact_forces(p, s.porous_porous, law, force, still_x,
+                                                state.porous.crack_contacts);
             touching += add_wall_contact_forces(p, s.porous_wall, model.walls.x, law, force);
             if (sub == 0) s.contacts = touching;
             move_fragments(model, state, force, h);
             for (Index k = 0; k < p.size(); ++k) mean[k] += force[k] / substeps;
         }
         s.force = std::move(mean);  // what the members felt on average: the Biot loads
+        if (!state.porous.crack_contacts.empty())
+            forget_parted_pairs(state.porous.crack_contacts, p, contact_positions(state), model.dx);
     }
     std::vector<char> inside(p.size(), 1);
     parallel_for(p.size(), [&](Index k) {
@@ -195,6 +180,56 @@ void advance_fragments(const Model& model, State& state, Real dt) {
         s.pairs_stale = true;
         refresh_fragment_mass(state, model.dx);
     }
+}
+
+/// [D] Where a free fragment meets an anchored structure: the structure's undeformed surface
+/// (rest_x), at rest, as linear elasticity poses its loads on the undeformed body. A contact that
+/// followed u fed the spring's answer to u back into the next Biot call's loads, which rang a
+/// nearly cut-off part of a cracked body up by decimetres within three calls; and a surface that
+/// moved with u did work on the fragments resting on it (followed up to 0.1 dx, the collapsing
+/// demo gained 12 % of the energy it had released).
+std::vector<Vec3> contact_positions(const State& state) {
+    const PorousParticles& p = state.porous.particles;
+    const StructureState& st = state.structures;
+    std::vector<Vec3> x = p.x;
+    if (st.empty()) return x;
+    parallel_for(p.size(), [&](Index k) {
+        const Index id = p.id[k];
+        if (size_t(id) < st.node_of.size() && st.node_of[id].first >= 0) x[k] = st.rest_x[id];
+    });
+    return x;
+}
+
+Real contact_energy(const Model& model, const State& state) {
+    const PorousParticles& p = state.porous.particles;
+    if (p.size() == 0) return 0;
+    const ContactLaw law = fragment_contact_law(model, state);
+    if (law.stiffness == 0) return 0;
+    const std::vector<Vec3> x = contact_positions(state);
+    Aabb box{x[0], x[0]};
+    for (const Vec3& y : x) box.extend(y);
+    const UniformGrid grid(box.padded(model.h), model.h);  // cells of h >= d0: few, for any spread
+    CellRanges cells;
+    sort_into_cells(grid, x, cells);
+    const std::span<const CrackContact> cracked = state.porous.crack_contacts;
+    const auto spring = [&](Real scale, Real rest, Real r) {
+        return scale > 0 && r < rest ? 0.5 * scale * law.stiffness * (rest - r) * (rest - r) : 0;
+    };
+    return deterministic_sum(p.size(), Real(0), [&](Index i) {
+        Real e = 0;
+        for_each_within(grid, cells, x[i], law.rest_distance, [&](Index j, const Vec3& xj) {
+            if (j <= i || p.fragment[i] == p.fragment[j] || p.origin[i] == p.origin[j]) return;
+            const Real rest = pair_rest_distance(cracked, p.id[i], p.id[j], law.rest_distance);
+            e += spring(law.pair_scale(p.fragment[i], p.fragment[j]), rest, (xj - x[i]).norm());
+        });
+        const Real scale = law.pair_scale(p.fragment[i], p.fragment[i]);
+        if (scale > 0 && !model.walls.cells.start.empty())
+            for_each_within(model.grid, model.walls.cells, x[i], law.rest_distance,
+                            [&](Index, const Vec3& xw) {
+                                e += spring(scale, law.rest_distance, (xw - x[i]).norm());
+                            });
+        return e;
+    });
 }
 
 Fragment free_fragment(PorousParticles& p, const std::vector<Index>& members, Real spacing) {

@@ -12,6 +12,15 @@ namespace karst {
 /// K = R K0 R^T (M12). Porous particles leaving the domain are removed and counted.
 void advance_fragments(const Model& model, State& state, Real dt);
 
+/// Where each porous particle meets the others by contact: a member of an anchored structure on
+/// its undeformed position (rest_x), every other particle where it is.
+std::vector<Vec3> contact_positions(const State& state);
+
+/// The elastic energy of the contact springs that touch, sum 1/2 s k_c (rest - r)^2 over pairs
+/// of fragments and over fragments and walls, J: the potential energy of the contacts, which
+/// the energy account counts (sim/energy.hpp).
+Real contact_energy(const Model& model, const State& state);
+
 /// A free rigid fragment of `members` in their current pose (rest orientation: body frame =
 /// world frame): mass properties, and the linear and angular momentum the members carry, so
 /// that neither changes. Writes the members' body-frame positions and tensors.

@@ -31,9 +31,14 @@ void fields(Ar& ar, Fragment& f) {
 }
 
 template <class Ar>
+void fields(Ar& ar, CrackContact& c) {
+    ar(c.lo, c.hi, c.rest);
+}
+
+template <class Ar>
 void fields(Ar& ar, PorousState& s) {
     ar(s.particles, s.fragments, s.absorbed, s.dissolved, s.fluid_deleted, s.removed,
-       s.pore_substeps);
+       s.pore_substeps, s.crack_contacts);
 }
 
 template <class Ar>
@@ -107,7 +112,7 @@ void fields(Ar& ar, SupportLog& l) {
 template <class Ar>
 void fields(Ar& ar, FrameLog& l) {
     ar(l.time, l.dt, l.steps, l.particles, l.density_error, l.mipps, l.kinetic_energy,
-       l.potential_energy, l.removed, l.speed_p99, l.max_speed, l.supports);
+       l.potential_energy, l.contact_energy, l.removed, l.speed_p99, l.max_speed, l.supports);
 }
 
 template <class Ar>

@@ -1,6 +1,7 @@
 #include "karst/sim/energy.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/rigid/fragment_motion.hpp"
 
 #include <algorithm>
 
@@ -26,6 +27,7 @@ Energy mechanical_energy(const Model& model, const State& state) {
     e.potential += deterministic_sum(p.size(), Real(0), [&](Index i) {
         return -(p.solid_mass[i] + p.absorbed_mass[i]) * g.dot(p.x[i]);
     });
+    e.contact = contact_energy(model, state);
     return e;
 }
 
@@ -40,7 +42,7 @@ std::pair<Real, Real> fluid_speed_p99_and_max(const FluidParticles& f) {
 }
 
 void EnergyAccount::add(const Energy& e) {
-    m_released = std::max(m_released, m_start.kinetic + m_start.potential - e.potential);
+    m_released = std::max(m_released, m_start.total() - e.potential);
     m_largest_gain = std::max(m_largest_gain, e.total() - m_lowest);
     m_largest_rise = std::max(m_largest_rise, e.total() - m_start.total());
     if (m_released > 0)

@@ -1,7 +1,8 @@
 #pragma once
 // The mechanical energy account (issue 11): kinetic and potential energy of the fluid and the
-// porous particles (which carry their fragments' mass: grains and pore water). A closed system
-// may lose energy to viscosity and inelastic impacts, never gain it; the account says when it did.
+// porous particles (which carry their fragments' mass: grains and pore water), and the elastic
+// energy of the fragments' contact springs. A closed system may lose energy to viscosity and
+// inelastic impacts, never gain it; the account says when it did.
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 
@@ -10,19 +11,21 @@ namespace karst {
 struct Energy {
     Real kinetic = 0;    ///< sum 1/2 m |v|^2, J
     Real potential = 0;  ///< sum -m g.x (zero at the origin), J
-    Real total() const { return kinetic + potential; }
+    Real contact = 0;    ///< the touching contact springs, sum 1/2 s k_c (rest - r)^2, J
+    Real total() const { return kinetic + potential + contact; }
 };
 
 /// Kinetic and potential energy of the fluid (true mass m) and the porous particles
-/// (grains + pore water, moving with their fragment's rigid velocity). Thread-count independent.
+/// (grains + pore water, moving with their fragment's rigid velocity), and the contact springs'
+/// energy (rigid/fragment_motion.hpp). Thread-count independent.
 Energy mechanical_energy(const Model& model, const State& state);
 
 /// The 99th percentile and the maximum of the fluid particles' speeds, m/s.
 std::pair<Real, Real> fluid_speed_p99_and_max(const FluidParticles& fluid);
 
 /// Follows the energy frame by frame. `released` is what the motion has had to spend: the
-/// initial kinetic energy plus the largest drop of potential energy so far. A rise of the total
-/// over its lowest value so far is energy the numerics made.
+/// initial kinetic and contact energy plus the largest drop of potential energy so far. A rise of
+/// the total over its lowest value so far is energy the numerics made.
 class EnergyAccount {
 public:
     EnergyAccount() = default;
@@ -40,8 +43,8 @@ public:
     /// The account's fields for a checkpoint (io/binary_archive.hpp).
     template <class Archive>
     friend void fields(Archive& ar, EnergyAccount& a) {
-        ar(a.m_start.kinetic, a.m_start.potential, a.m_lowest, a.m_released, a.m_largest_gain,
-           a.m_largest_rise, a.m_worst_ratio);
+        ar(a.m_start.kinetic, a.m_start.potential, a.m_start.contact, a.m_lowest, a.m_released,
+           a.m_largest_gain, a.m_largest_rise, a.m_worst_ratio);
     }
 
 private:

@@ -239,7 +239,7 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         out->write_boundary(model.walls);
         out->folder().write("render.json",
                             render_settings_json(scene.render, pictured_walls(scene)));
-        // The energy account (issue 11): a rise of kinetic + potential energy over 5 % of the
+        // The energy account (issue 11): a rise of the mechanical energy over 5 % of the
         // energy released so far is energy the numerics made; the run says so once.
         record.energy = EnergyAccount(mechanical_energy(model, state));
     }
@@ -259,13 +259,14 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
         log.kinetic_energy = e.kinetic, log.potential_energy = e.potential,
-        log.removed = state.removed;
+        log.contact_energy = e.contact, log.removed = state.removed;
         std::tie(log.speed_p99, log.max_speed) = fluid_speed_p99_and_max(state.fluid);
         record.energy.add(e);
         if (!record.energy_warned && record.energy.gained_more_than(0.05)) {
             record.energy_warned = true;
             progress.warn(fmt::format(
-                "t = {:.4g} s: the kinetic + potential energy rose by {:.3g} J, {:.0f} % of the "
+                "t = {:.4g} s: the mechanical energy (kinetic, potential, contact) rose by {:.3g} "
+                "J, {:.0f} % of the "
                 "{:.3g} J released so far (log.csv has the account)",
                 state.time, record.energy.largest_gain(), 100 * record.energy.worst_ratio(),
                 record.energy.released()));

@@ -5,6 +5,7 @@
 #include "karst/pfem/structure_state.hpp"
 #include "karst/porous/pore_flow.hpp"
 #include "karst/porous/pore_water.hpp"
+#include "karst/rigid/contact.hpp"
 #include "karst/rigid/fragment.hpp"
 #include "karst/sph/fluid_particles.hpp"
 #include "karst/sph/neighbour_grid.hpp"
@@ -50,6 +51,7 @@ struct PorousState {
     Index fluid_deleted = 0;  ///< drained fluid particles deleted (§4.7.3)
     Index removed = 0;        ///< porous particles that left the domain
     Index pore_substeps = 0;  ///< pore-flow sub-steps taken (§4.7.5), summed over steps
+    std::vector<CrackContact> crack_contacts;  ///< springs a crack left short (M27), sorted
     Index size() const { return particles.size(); }
 };
 
