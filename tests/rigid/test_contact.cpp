@@ -50,16 +50,24 @@ TEST(Contact, NoForceWithinOneFragment) {
     EXPECT_EQ(force[0], Vec3::Zero());
 }
 
+/// Fragments 0 and 1 of mass 1 kg, free or anchored.
+std::vector<Fragment> two_fragments(bool first_anchored, bool second_anchored) {
+    std::vector<Fragment> f(2);
+    f[0].mass = f[1].mass = 1;
+    f[0].anchored = first_anchored, f[1].anchored = second_anchored;
+    return f;
+}
+
 TEST(Contact, APairACrackLeftShortPushesOnlyWhenItClosesFurther) {
     const Real dx = 0.02;
     Collision c(0.9 * dx, 0.0, 1);
     c.p.id = {10, 11};
     const ContactLaw law = ContactLaw::for_fragments(dx, 1.0, 9.81, c.m, 0.2);
-    // One body (both flagged) that a crack split into fragments 0 and 1 at 0.9 dx.
+    // One body that a crack split into the free fragments 0 and 1, 0.9 dx apart.
     std::vector<CrackContact> cracked;
-    const std::vector<char> both{1, 1};
+    const std::vector<char> both{1, 1}, copies{0, 1};
     const std::vector<Vec3> before{Vec3(0, 0, 0), Vec3(dx, 0, 0)};
-    rest_after_split(cracked, c.p, both, before, c.p.x, c.p.id, dx);
+    rest_after_split(cracked, c.p, two_fragments(false, false), {both, copies, before, c.p.x}, dx);
     ASSERT_EQ(cracked.size(), 1u);
     EXPECT_EQ(cracked[0].lo, 10);
     EXPECT_EQ(cracked[0].hi, 11);
@@ -92,34 +100,43 @@ TEST(Contact, APairACrackLeftShortPushesOnlyWhenItClosesFurther) {
     EXPECT_TRUE(kept.empty()) << "a pair merged into one fragment is forgotten";
 }
 
-TEST(Contact, ASplitKeepsTheLoadOfASpringAgainstAnotherFragment) {
+TEST(Contact, ASplitLoadsNoSpring) {
     const Real dx = 0.02;
-    // Particle 0 belongs to the body the crack split; particle 1 is a fragment resting on it,
-    // sunk 0.05 dx. The split's offset moved particle 0 another 0.05 dx closer.
+    // Particle 0 belongs to the anchored body the crack split (fragment 0); particle 1 is a free
+    // fragment resting on it, sunk 0.05 dx. The split's offset moved particle 0 another 0.05 dx
+    // closer.
     Collision c(0.9 * dx, 0.0, 1);
     c.p.id = {3, 4};
-    const std::vector<char> body{1, 0};
+    const std::vector<char> body{1, 0}, kept_id{0, 0}, new_id{1, 0};
     const std::vector<Vec3> before{Vec3(-0.05 * dx, 0, 0), Vec3(0.9 * dx, 0, 0)};
+    const std::vector<Fragment> resting = two_fragments(true, false);
     std::vector<CrackContact> pairs;
-    rest_after_split(pairs, c.p, body, before, c.p.x, c.p.id, dx);
+    rest_after_split(pairs, c.p, resting, {body, kept_id, before, c.p.x}, dx);
     ASSERT_EQ(pairs.size(), 1u);
     EXPECT_NEAR(pairs[0].rest, 0.95 * dx, 1e-15) << "the same 0.05 dx of load, none added";
-    rest_after_split(pairs, c.p, body, c.p.x, c.p.x, c.p.id, dx);
+    rest_after_split(pairs, c.p, resting, {body, kept_id, c.p.x, c.p.x}, dx);
     EXPECT_NEAR(pairs[0].rest, 0.95 * dx, 1e-15) << "a split that did not move it keeps it";
 
-    c.p.id = {5, 4};  // particle 0 is now a copy of id 3, split off where its parent was
-    const std::vector<Index> was{3, 4};
-    rest_after_split(pairs, c.p, body, c.p.x, c.p.x, was, dx);
-    ASSERT_EQ(pairs.size(), 2u);
-    EXPECT_NEAR(pair_rest_distance(pairs, 5, 4, dx), 0.95 * dx, 1e-15) << "the parent's rest";
-    c.p.id = {3, 4};
+    std::vector<CrackContact> fresh;
+    rest_after_split(fresh, c.p, resting, {body, new_id, before, c.p.x}, dx);
+    ASSERT_EQ(fresh.size(), 1u);
+    EXPECT_NEAR(fresh[0].rest, 0.9 * dx, 1e-15)
+        << "a copy beside its parent starts unloaded, or the split doubles the spring's load";
 
     std::vector<CrackContact> none;
+    rest_after_split(none, c.p, two_fragments(true, true), {body, kept_id, before, c.p.x}, dx);
+    EXPECT_TRUE(none.empty()) << "two anchored fragments have no spring";
+    rest_after_split(none, c.p, two_fragments(false, true), {body, kept_id, before, c.p.x}, dx);
+    ASSERT_EQ(none.size(), 1u);
+    EXPECT_NEAR(none[0].rest, 0.9 * dx, 1e-15)
+        << "freed beside an anchored fragment, where no spring acted: unloaded";
+    none.clear();
     const std::vector<Vec3> apart{Vec3(0.1 * dx, 0, 0), Vec3(0.9 * dx, 0, 0)};
-    rest_after_split(none, c.p, body, apart, c.p.x, c.p.id, dx);
+    rest_after_split(none, c.p, resting, {body, kept_id, apart, c.p.x}, dx);
     EXPECT_TRUE(none.empty()) << "a split that moved it away leaves the law's d0";
     c.p.origin = {3, 3};
-    rest_after_split(none, c.p, std::vector<char>{1, 1}, c.p.x, c.p.x, c.p.id, dx);
+    const std::vector<char> both{1, 1};
+    rest_after_split(none, c.p, two_fragments(false, false), {both, kept_id, c.p.x, c.p.x}, dx);
     EXPECT_TRUE(none.empty()) << "no spring between halves of one split particle";
 }
 

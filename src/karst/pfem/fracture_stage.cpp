@@ -230,11 +230,18 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
         // velocities only spread a quasi-static call's u over dt_B (sim/energy.cpp counts them
         // no kinetic energy). So a piece cut from it starts at rest; inheriting them gave an
         // arch's pieces more kinetic energy than its weight and elasticity had released.
-        // [D] It starts on its undeformed positions, where the fragments' contacts met it
-        // (rigid/fragment_motion.cpp): on X + u it overlapped the fragments that rested on it,
-        // and their springs threw them up with energy no crack had released.
+        // [D] It starts in its undeformed shape X (a rigid body has no strain), moved by its
+        // members' mass-weighted mean u, so its mass centre stays where it sagged to: on X alone
+        // it rose by its sag, energy from nothing, and on X + u it kept a strained shape.
+        Vec3 shift = Vec3::Zero();
+        Real mass = 0;
+        for (Index i : members[c]) {
+            const Real m = p.solid_mass[i] + p.absorbed_mass[i];
+            shift += m * (p.x[i] - st.rest_x[p.id[i]]), mass += m;
+        }
+        if (mass > 0) shift /= mass;
         for (Index i : members[c])
-            p.fragment[i] = f, p.v[i] = Vec3::Zero(), p.x[i] = st.rest_x[p.id[i]];
+            p.fragment[i] = f, p.v[i] = Vec3::Zero(), p.x[i] = st.rest_x[p.id[i]] + shift;
         state.porous.fragments.push_back(free_fragment(p, members[c], model.dx));
         ++st.fracture.fragments_created;
     }
@@ -280,13 +287,12 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     // (rigid/contact.hpp): neither between its pieces nor against the fragments around them.
     const std::vector<Vec3> after = contact_positions(state);
     std::vector<Vec3> before = after;
-    std::vector<char> in_split(p.size(), 0);
-    std::vector<Index> was = p.id;
+    std::vector<char> body(p.size(), 0), copy(p.size(), 0);
     for (Index k = 0; k < n_new; ++k)
         if (const Index i = particle[node_id[k]]; i >= 0)
-            in_split[i] = 1, before[i] = rest_before[split.source[k]],
-            was[i] = node_id[split.source[k]];
-    rest_after_split(state.porous.crack_contacts, p, in_split, before, after, was, model.dx);
+            body[i] = 1, copy[i] = k >= n_old, before[i] = rest_before[split.source[k]];
+    rest_after_split(state.porous.crack_contacts, p, state.porous.fragments,
+                     {body, copy, before, after}, model.dx);
     return true;
 }
 

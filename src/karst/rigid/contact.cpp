@@ -26,34 +26,41 @@ Real pair_rest_distance(std::span<const CrackContact> sorted, Index a, Index b, 
 }
 
 void rest_after_split(std::vector<CrackContact>& pairs, const PorousParticles& p,
-                      std::span<const char> split, std::span<const Vec3> before,
-                      std::span<const Vec3> after, std::span<const Index> was, Real d0) {
-    const auto first = std::find(split.begin(), split.end(), 1);
-    if (first == split.end()) return;
-    // The particles within d0 of the body's box, in a grid of cell d0.
-    Aabb box{after[first - split.begin()], after[first - split.begin()]};
+                      const std::vector<Fragment>& fragments, const SplitParticles& split,
+                      Real d0) {
+    const auto first = std::find(split.body.begin(), split.body.end(), 1);
+    if (first == split.body.end()) return;
+    const auto moves = [&](Index i) {
+        const Fragment& f = fragments[size_t(p.fragment[i])];
+        return !f.anchored && f.mass > 0;
+    };
+    // The particles within d0 of the body's box, in a grid of cell 2 d0 (= h, as the fluid's).
+    const std::span<const Vec3> x = split.after;
+    Aabb box{x[first - split.body.begin()], x[first - split.body.begin()]};
     for (Index i = 0; i < p.size(); ++i)
-        if (split[i]) box.extend(after[i]);
+        if (split.body[i]) box.extend(x[i]);
     box = box.padded(d0);
     std::vector<Index> near;
     std::vector<Vec3> near_x;
     for (Index i = 0; i < p.size(); ++i)
-        if (box.contains(after[i])) near.push_back(i), near_x.push_back(after[i]);
-    const UniformGrid grid(box, d0);
+        if (box.contains(x[i])) near.push_back(i), near_x.push_back(x[i]);
+    const UniformGrid grid(box, 2 * d0);
     CellRanges cells;
     sort_into_cells(grid, near_x, cells);
     std::vector<CrackContact> fresh;
     for (Index i = 0; i < p.size(); ++i) {
-        if (!split[i]) continue;
-        for_each_within(grid, cells, after[i], [&](Index k, const Vec3& xj) {
+        if (!split.body[i]) continue;
+        for_each_within(grid, cells, x[i], d0, [&](Index k, const Vec3& xj) {
             const Index j = near[size_t(k)];
             if (p.fragment[i] == p.fragment[j] || p.origin[i] == p.origin[j]) return;
-            if (split[j] && p.id[j] < p.id[i]) return;  // each pair of the body once
-            const Real r = (xj - after[i]).norm();
+            if (!moves(i) && !moves(j)) return;              // no spring
+            if (split.body[j] && p.id[j] < p.id[i]) return;  // each pair of the body once
+            const Real r = (xj - x[i]).norm();
             Real rest = r;
-            if (!split[j]) {
-                const Real closed = (before[j] - before[i]).norm() - r;
-                rest = pair_rest_distance(pairs, was[i], p.id[j], d0) - std::max(closed, Real(0));
+            // The body was anchored, so only a pair with a free fragment had a spring.
+            if (!split.body[j] && !split.copy[i] && moves(j)) {
+                const Real closed = (split.before[j] - split.before[i]).norm() - r;
+                rest = pair_rest_distance(pairs, p.id[i], p.id[j], d0) - std::max(closed, Real(0));
                 if (rest >= d0) return;
             }
             fresh.push_back({std::min(p.id[i], p.id[j]), std::max(p.id[i], p.id[j]), rest});

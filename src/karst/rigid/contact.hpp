@@ -5,6 +5,7 @@
 // so only pairs across fragments count; and none between the halves of one split particle (M27),
 // which overlap by construction.
 #include "karst/porous/pore_water.hpp"
+#include "karst/rigid/fragment.hpp"
 #include "karst/sph/neighbour_grid.hpp"
 
 #include <algorithm>
@@ -60,19 +61,24 @@ struct CrackContact {
 /// (lo, hi)), else d0.
 Real pair_rest_distance(std::span<const CrackContact> sorted, Index a, Index b, Real d0);
 
-/// The rest lengths after a crack moved the particles of one body apart (M27). `split` flags
-/// the body's particles (one fragment before the crack), `before` and `after` are every
-/// particle's contact positions around the split (the others did not move), `was` the id each
-/// particle had before it (a copy's parent's). A pair of the body that the crack put in
-/// different fragments starts unloaded: its rest is its distance. A pair between the body and
-/// another fragment keeps the load it had (a copy, its parent's) and takes none from the split:
-/// its rest shortens by what the split closed it. Entries made here replace older ones.
+/// What a split did to the particles of one anchored body (M27), per porous particle.
+struct SplitParticles {
+    std::span<const char> body;    ///< a particle of the body (one fragment before the split)
+    std::span<const char> copy;    ///< a copy the split made (a new id)
+    std::span<const Vec3> before;  ///< contact positions before the split (others: unmoved)
+    std::span<const Vec3> after;   ///< and after it
+};
+
+/// The rest lengths after a split, so that it loads no spring. A spring that acts now starts
+/// unloaded (its rest is its distance) unless it acted before with a load, which it keeps: a
+/// pair between a particle that keeps its id and a free fragment's, whose rest shortens by what
+/// the split's offsets closed it. Pairs between anchored fragments have no spring and no entry.
+/// Entries made here replace older ones.
 void rest_after_split(std::vector<CrackContact>& pairs, const PorousParticles& particles,
-                      std::span<const char> split, std::span<const Vec3> before,
-                      std::span<const Vec3> after, std::span<const Index> was, Real d0);
+                      const std::vector<Fragment>& fragments, const SplitParticles& split, Real d0);
 
 /// Forgets the pairs that parted by d0 at positions `x` (one per particle), that now share a
-/// fragment, or whose particles are gone.
+/// fragment, or whose particles are gone (the run calls it every step there are entries).
 void forget_parted_pairs(std::vector<CrackContact>& pairs, const PorousParticles& particles,
                          std::span<const Vec3> x, Real d0);
 

@@ -165,9 +165,9 @@ void advance_fragments(const Model& model, State& state, Real dt) {
             for (Index k = 0; k < p.size(); ++k) mean[k] += force[k] / substeps;
         }
         s.force = std::move(mean);  // what the members felt on average: the Biot loads
-        if (!state.porous.crack_contacts.empty())
-            forget_parted_pairs(state.porous.crack_contacts, p, contact_positions(state), model.dx);
     }
+    if (!state.porous.crack_contacts.empty())
+        forget_parted_pairs(state.porous.crack_contacts, p, contact_positions(state), model.dx);
     std::vector<char> inside(p.size(), 1);
     parallel_for(p.size(), [&](Index k) {
         inside[k] = state.porous.fragments[p.fragment[k]].anchored || model.domain.contains(p.x[k]);
@@ -213,7 +213,9 @@ Real contact_energy(const Model& model, const State& state) {
     sort_into_cells(grid, x, cells);
     const std::span<const CrackContact> cracked = state.porous.crack_contacts;
     const auto spring = [&](Real scale, Real rest, Real r) {
-        return scale > 0 && r < rest ? 0.5 * scale * law.stiffness * (rest - r) * (rest - r) : 0;
+        return scale > 0 && r > 0 && r < rest
+                   ? 0.5 * scale * law.stiffness * (rest - r) * (rest - r)
+                   : 0;
     };
     return deterministic_sum(p.size(), Real(0), [&](Index i) {
         Real e = 0;
