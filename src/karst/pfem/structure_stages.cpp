@@ -27,12 +27,6 @@ constexpr Real k_distorted_dihedral_deg = 2;
 
 }  // namespace
 
-std::vector<Index> index_by_id(const PorousParticles& p, size_t ids) {
-    std::vector<Index> index(ids, -1);
-    for (Index i = 0; i < p.size(); ++i) index[p.id[i]] = i;
-    return index;
-}
-
 namespace {
 
 /// Per node of structure s, the value of its particle id in the per-id array `by_id`.

@@ -10,9 +10,6 @@
 
 namespace karst {
 
-/// Particle index of each porous particle id below `ids`, -1 for ids no longer present.
-std::vector<Index> index_by_id(const PorousParticles& p, size_t ids);
-
 /// The solver of structure `slot`, built (and its mobility brought to the last feedback) when
 /// the cache has none for the current mesh.
 BiotSolver& solver_of(const Model& model, State& state, size_t slot);

@@ -40,6 +40,14 @@ struct PorousParticles {
     }
 };
 
+/// Particle index of each porous particle id below `ids` (every id present must be below it),
+/// -1 for ids no longer present.
+inline std::vector<Index> index_by_id(const PorousParticles& p, size_t ids) {
+    std::vector<Index> index(ids, -1);
+    for (Index i = 0; i < p.size(); ++i) index[size_t(p.id[i])] = i;
+    return index;
+}
+
 /// Below this porosity a particle is impermeable (M3) and takes part in no transfer.
 inline constexpr Real k_min_porosity = 1e-4;
 

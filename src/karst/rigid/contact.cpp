@@ -2,6 +2,7 @@
 
 #include "karst/core/parallel.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -77,11 +78,9 @@ void rest_after_split(std::vector<CrackContact>& pairs, const PorousParticles& p
 void forget_parted_pairs(std::vector<CrackContact>& pairs, const PorousParticles& p,
                          std::span<const Vec3> x, Real d0) {
     if (pairs.empty()) return;
-    Index top = 0;
-    for (Index id : p.id) top = std::max(top, id);
-    std::vector<Index> index_of(size_t(top) + 1, -1);
-    for (Index k = 0; k < p.size(); ++k) index_of[size_t(p.id[k])] = k;
-    const auto at = [&](Index id) { return id <= top ? index_of[size_t(id)] : Index(-1); };
+    const size_t ids = p.size() > 0 ? size_t(*std::ranges::max_element(p.id)) + 1 : 0;
+    const std::vector<Index> index_of = index_by_id(p, ids);
+    const auto at = [&](Index id) { return size_t(id) < ids ? index_of[size_t(id)] : Index(-1); };
     std::erase_if(pairs, [&](const CrackContact& c) {
         const Index i = at(c.lo), j = at(c.hi);
         return i < 0 || j < 0 || p.fragment[i] == p.fragment[j] || (x[i] - x[j]).norm() >= d0;

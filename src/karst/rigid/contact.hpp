@@ -46,9 +46,11 @@ struct ContactLaw {
 };
 
 /// A pair of porous particles, by id (lo < hi), that a crack left closer than d0, and the rest
-/// length of its spring: the distance the crack left them at. M27's offsets can bring lattice
-/// neighbours across a crack closer than d0; with the law's d0 their springs would throw the
-/// pieces apart with energy no crack released. The rest length holds until the pair parts by d0.
+/// length of its spring (rest_after_split): the distance the crack left them at, or, for a
+/// loaded pair against a free fragment, its old rest less what the crack closed it. M27's
+/// offsets can bring lattice neighbours across a crack closer than d0; with the law's d0 their
+/// springs would throw the pieces apart with energy no crack released. The entry holds until
+/// the pair parts by d0, comes to share a fragment or loses a particle (forget_parted_pairs).
 struct CrackContact {
     Index lo = 0, hi = 0;
     Real rest = 0;

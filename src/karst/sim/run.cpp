@@ -265,9 +265,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         if (!record.energy_warned && record.energy.gained_more_than(0.05)) {
             record.energy_warned = true;
             progress.warn(fmt::format(
-                "t = {:.4g} s: the mechanical energy (kinetic, potential, contact) rose by {:.3g} "
-                "J, {:.0f} % of the "
-                "{:.3g} J released so far (log.csv has the account)",
+                "t = {:.4g} s: the mechanical energy (kinetic, potential, contact) rose by "
+                "{:.3g} J, {:.0f} % of the {:.3g} J released so far (log.csv has the account)",
                 state.time, record.energy.largest_gain(), 100 * record.energy.worst_ratio(),
                 record.energy.released()));
         }
