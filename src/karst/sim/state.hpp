@@ -18,6 +18,15 @@ namespace karst {
 
 struct Model;
 
+/// Per fluid particle i, its boundary pairs (walls and porous, coefficients c_ik and hydrostatic
+/// terms h_ik of pressure_pair_coefficients) summed once per step: the pressure solves' boundary
+/// terms are linear in p_i and v_i wherever no hydrostatic clamp acts, and then need no pair loop.
+struct BoundarySums {
+    std::vector<Vec3> gradient;     ///< sum_k c_ik x_ik
+    std::vector<Vec3> hydrostatic;  ///< sum_k c_ik h_ik x_ik
+    std::vector<Real> lowest;       ///< min(min_k h_ik, 0), Pa: p_i + lowest >= 0 means no clamp
+};
+
 /// Data rebuilt every step from the physical state.
 struct FluidScratch {
     CellRanges cells;                      ///< fluid particles sorted by cell
@@ -38,6 +47,7 @@ struct FluidScratch {
     NeighbourLists fluid_porous;           ///< porous neighbours within h (Akinci boundary, §4.1)
     std::vector<Real> porous_coefficient;  ///< per porous pair: Psi_k / rho0^2 dW/dr / r
     std::vector<Real> porous_hydrostatic;  ///< per porous pair: -rho0 g.x_ik, Pa
+    BoundarySums boundary_sums;            ///< (n) the boundary pairs summed (walls and porous)
     std::vector<Vec3> porous_v_pred;       ///< per porous particle: its velocity in the solve, m/s
 };
 

@@ -20,8 +20,7 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0, scale = dt * dt / rho0_2;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
-              cap_p = s.fluid_porous.capacity;
+    const int cap_f = s.fluid_fluid.capacity, cap_p = s.fluid_porous.capacity;
     const PorousParticles& porous = state.porous.particles;
     const std::vector<Fragment>& fragments = state.porous.fragments;
     std::vector<Mat3> inverse_inertia(fragments.size(), Mat3::Zero());
@@ -31,7 +30,8 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
     s.diagonal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i];
-        Vec3 fluid = Vec3::Zero(), boundary = Vec3::Zero();
+        Vec3 fluid = Vec3::Zero();
+        const Vec3 boundary = rho0_2 * s.boundary_sums.gradient[i];  // sum_k Psi_k grad W_ik
         Real squares = 0;
         const Real* cf = s.pair_coefficient.data() + i * cap_f;
         int k = 0;
@@ -40,10 +40,6 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
             fluid += g;
             squares += g.squaredNorm();
         });
-        const Real* cw = s.wall_coefficient.data() + i * cap_w;
-        k = 0;
-        s.fluid_wall.for_each(
-            i, [&](Index w) { boundary += (rho0_2 * cw[k++]) * (xi - model.walls.x[w]); });
         const Real* cp = s.porous_coefficient.data() + i * cap_p;
         k = 0;
         // The free fragments touched, in list order (a particle touches one or two).
@@ -52,7 +48,6 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
         int n_touched = 0;
         s.fluid_porous.for_each(i, [&](Index w) {
             const Vec3 g = (rho0_2 * cp[k++]) * (xi - porous.x[w]);  // Psi_k grad W_ik
-            boundary += g;
             const Index q = porous.fragment[w];
             if (fragments[q].anchored || fragments[q].mass <= 0) return;
             int slot = 0;
@@ -92,21 +87,19 @@ Real density_change(const Model& model, const State& state, const std::vector<Ve
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0;
-    const int cap_f = s.fluid_fluid.capacity, cap_w = s.fluid_wall.capacity,
-              cap_p = s.fluid_porous.capacity;
+    const int cap_f = s.fluid_fluid.capacity, cap_p = s.fluid_porous.capacity;
     const Vec3 xi = f.x[i], vi = v[i];
-    Real fluid = 0, boundary = 0;
+    Real fluid = 0;
     const Real* cf = s.pair_coefficient.data() + i * cap_f;
     int k = 0;
     s.fluid_fluid.for_each(i, [&](Index j) { fluid += cf[k++] * (vi - v[j]).dot(xi - f.x[j]); });
-    const Real* cw = s.wall_coefficient.data() + i * cap_w;
-    k = 0;
-    s.fluid_wall.for_each(i, [&](Index w) { boundary += cw[k++] * vi.dot(xi - model.walls.x[w]); });
+    // sum_k c_ik (v_i - v_k).x_ik: v_i against the step's sum, the moving porous members apart.
+    Real boundary = vi.dot(s.boundary_sums.gradient[i]);
     const std::vector<Vec3>& porous_x = state.porous.particles.x;
     const Real* cp = s.porous_coefficient.data() + i * cap_p;
     k = 0;
     s.fluid_porous.for_each(
-        i, [&](Index w) { boundary += cp[k++] * (vi - v_porous[w]).dot(xi - porous_x[w]); });
+        i, [&](Index w) { boundary -= cp[k++] * v_porous[w].dot(xi - porous_x[w]); });
     return dt * rho0_2 * (fluid + 2 * boundary);
 }
 

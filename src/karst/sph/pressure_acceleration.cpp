@@ -2,6 +2,8 @@
 
 #include "karst/core/parallel.hpp"
 
+#include <algorithm>
+
 namespace karst {
 
 void pressure_pair_coefficients(const Model& model, State& state) {
@@ -19,7 +21,14 @@ void pressure_pair_coefficients(const Model& model, State& state) {
     s.wall_hydrostatic.resize(size_t(f.size()) * cap_w);
     s.porous_coefficient.resize(size_t(f.size()) * cap_p);
     s.porous_hydrostatic.resize(size_t(f.size()) * cap_p);
+    BoundarySums& sums = s.boundary_sums;
+    sums.gradient.resize(f.size()), sums.hydrostatic.resize(f.size()), sums.lowest.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
+        Vec3 gradient = Vec3::Zero(), hydrostatic = Vec3::Zero();
+        Real lowest = 0;
+        const auto add = [&](Real c, Real h, const Vec3& xik) {
+            gradient += c * xik, hydrostatic += (c * h) * xik, lowest = std::min(lowest, h);
+        };
         int k = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
             s.pair_coefficient[i * cap_f + k++] =
@@ -30,15 +39,20 @@ void pressure_pair_coefficients(const Model& model, State& state) {
             const Vec3 xik = f.x[i] - model.walls.x[w];
             s.wall_coefficient[i * cap_w + k] =
                 boundary_pressure_coefficient(model.walls.psi[w], inv_rho0_2, W, xik);
-            s.wall_hydrostatic[i * cap_w + k++] = -rho0_g.dot(xik);
+            s.wall_hydrostatic[i * cap_w + k] = -rho0_g.dot(xik);
+            add(s.wall_coefficient[i * cap_w + k], s.wall_hydrostatic[i * cap_w + k], xik);
+            ++k;
         });
         k = 0;
         s.fluid_porous.for_each(i, [&](Index w) {
             const Vec3 xik = f.x[i] - porous.x[w];
             s.porous_coefficient[i * cap_p + k] =
                 boundary_pressure_coefficient(psi[w], inv_rho0_2, W, xik);
-            s.porous_hydrostatic[i * cap_p + k++] = -rho0_g.dot(xik);
+            s.porous_hydrostatic[i * cap_p + k] = -rho0_g.dot(xik);
+            add(s.porous_coefficient[i * cap_p + k], s.porous_hydrostatic[i * cap_p + k], xik);
+            ++k;
         });
+        sums.gradient[i] = gradient, sums.hydrostatic[i] = hydrostatic, sums.lowest[i] = lowest;
     });
 }
 

@@ -41,26 +41,32 @@ inline Vec3 pressure_acceleration(const Model& model, const State& state,
     const Real* cf = s.pair_coefficient.data() + i * cap_f;
     int k = 0;
     s.fluid_fluid.for_each(i, [&](Index j) { a -= ((pi + p[j]) * cf[k++]) * (xi - f.x[j]); });
-    if (pi != 0) {
-        const bool hydrostatic = boundary == BoundaryPressure::Hydrostatic;
-        const Real* cw = s.wall_coefficient.data() + i * cap_w;
-        const Real* hw = s.wall_hydrostatic.data() + i * cap_w;
-        k = 0;
-        s.fluid_wall.for_each(i, [&](Index w) {
-            a -= boundary_pressure_term(pi, cw[k], hydrostatic ? hw[k] : 0, xi - model.walls.x[w]);
-            ++k;
-        });
-        // Porous particles are boundary particles like walls (§4.3); their reaction is the same
-        // term, summed on the fragment side (coupling/fluid_reactions.cpp).
-        const std::vector<Vec3>& porous_x = state.porous.particles.x;
-        const Real* cp = s.porous_coefficient.data() + i * cap_p;
-        const Real* hp = s.porous_hydrostatic.data() + i * cap_p;
-        k = 0;
-        s.fluid_porous.for_each(i, [&](Index w) {
-            a -= boundary_pressure_term(pi, cp[k], hydrostatic ? hp[k] : 0, xi - porous_x[w]);
-            ++k;
-        });
+    if (pi == 0) return a * (f.sph_mass[i] / f.mass[i]);
+    const bool hydrostatic = boundary == BoundaryPressure::Hydrostatic;
+    const BoundarySums& sums = s.boundary_sums;
+    if (pi + (hydrostatic ? sums.lowest[i] : 0) >= 0) {
+        // No p_ik is clamped: the sum is linear, 2 p_i sum_k c_ik x_ik + sum_k c_ik h_ik x_ik.
+        a -= 2 * pi * sums.gradient[i];
+        if (hydrostatic) a -= sums.hydrostatic[i];
+        return a * (f.sph_mass[i] / f.mass[i]);
     }
+    const Real* cw = s.wall_coefficient.data() + i * cap_w;
+    const Real* hw = s.wall_hydrostatic.data() + i * cap_w;
+    k = 0;
+    s.fluid_wall.for_each(i, [&](Index w) {
+        a -= boundary_pressure_term(pi, cw[k], hydrostatic ? hw[k] : 0, xi - model.walls.x[w]);
+        ++k;
+    });
+    // Porous particles are boundary particles like walls (§4.3); their reaction is the same
+    // term, summed on the fragment side (coupling/fluid_reactions.cpp).
+    const std::vector<Vec3>& porous_x = state.porous.particles.x;
+    const Real* cp = s.porous_coefficient.data() + i * cap_p;
+    const Real* hp = s.porous_hydrostatic.data() + i * cap_p;
+    k = 0;
+    s.fluid_porous.for_each(i, [&](Index w) {
+        a -= boundary_pressure_term(pi, cp[k], hydrostatic ? hp[k] : 0, xi - porous_x[w]);
+        ++k;
+    });
     return a * (f.sph_mass[i] / f.mass[i]);  // a force per unit rho0 V acting on the true mass
 }
 
