@@ -119,9 +119,17 @@ TEST(CoupledStructure, WaterLayerLoadsAnAnchoredBlockAndItSettlesAsUnderTheEquiv
         << "mean top settlement, m";
 
     // 3. The particles follow: the top layer sits at X + u of the call before the last (they move
-    //    toward the last call's u over the next interval), which the steady load leaves unchanged.
-    EXPECT_NEAR(mean_sinking(sim.state.porous.particles, rest, top - 1e-9), coupled_top,
-                0.03 * std::abs(coupled_top))
+    //    toward the last call's u over the next interval, and the run ends on a call). Not against
+    //    the last call's u: the water above still moves (issue 11), so consecutive calls differ by
+    //    a few per cent, and by how much depends on the round-off of the fluid's sums.
+    const Structure& block = sim.state.structures.structures[0];
+    Real from_top = 0;
+    int from_nodes = 0;
+    for (Index a = 0; a < block.mesh.node_count(); ++a)
+        if (block.mesh.nodes[a][2] >= top - 1e-9) from_top += block.u_from[a][2], ++from_nodes;
+    from_top /= from_nodes;
+    EXPECT_NEAR(mean_sinking(sim.state.porous.particles, rest, top - 1e-9), from_top,
+                1e-6 * std::abs(from_top))
         << "m";
 }
 
