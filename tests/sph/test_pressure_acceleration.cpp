@@ -1,6 +1,7 @@
 // The pressure acceleration a_i^p (sph/pressure_acceleration.hpp) against its pair-by-pair
 // definition, walls and porous particles as boundary: the per-particle boundary sums it reads
-// where no hydrostatic clamp acts must give the same force as the clamped pair terms.
+// where no hydrostatic clamp acts must give the same force as the clamped pair terms, and the
+// densities computed in the same pass must be M7's (compute_density).
 #include "support/simulate.hpp"
 
 #include "karst/coupling/porous_boundary_volumes.hpp"
@@ -43,7 +44,7 @@ Vec3 by_pairs(const Model& model, const State& state, const std::vector<Real>& p
     return a * (f.sph_mass[i] / f.mass[i]);
 }
 
-TEST(PressureAcceleration, TheBoundarySumsGiveThePairByPairForceClampedOrNot) {
+TEST(PressureAcceleration, ItsPassGivesM7DensitiesAndTheBoundarySumsThePairByPairForce) {
     test::Simulation sim(R"({
       "name": "wet_corner", "particle_spacing": 0.02,
       "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.2, 0.2, 0.2] } } ],
@@ -58,9 +59,14 @@ TEST(PressureAcceleration, TheBoundarySumsGiveThePairByPairForceClampedOrNot) {
     update_fluid_neighbours(model, state);
     update_porous_neighbours(model, state);
     update_porous_boundary_volumes(model, state);
-    update_density(model, state);
-    pressure_pair_coefficients(model, state);
+    update_density_and_pair_coefficients(model, state);
     const FluidParticles& f = state.fluid;
+    std::vector<Real> rho;
+    compute_density(model, state, f.x, rho);
+    Real rho_worst = 0;
+    for (Index i = 0; i < f.size(); ++i)
+        rho_worst = std::max(rho_worst, std::abs(f.rho[i] - rho[i]));
+    EXPECT_LT(rho_worst, 1e-12 * model.rho0) << "kg/m^3";
     // Pressures from 0 to twice the hydrostatic span of a support radius (rho0 g h = 392 Pa):
     // the low ones clamp p_ik of the boundary particles above i, the high ones none.
     std::mt19937 random(7);

@@ -19,8 +19,9 @@ namespace karst {
 struct Model;
 
 /// Per fluid particle i, its boundary pairs (walls and porous, coefficients c_ik and hydrostatic
-/// terms h_ik of pressure_pair_coefficients) summed once per step: the pressure solves' boundary
-/// terms are linear in p_i and v_i wherever no hydrostatic clamp acts, and then need no pair loop.
+/// terms h_ik of update_density_and_pair_coefficients) summed once per step: the pressure solves'
+/// boundary terms are linear in p_i and v_i wherever no hydrostatic clamp acts, and then need no
+/// pair loop.
 struct BoundarySums {
     std::vector<Vec3> gradient;     ///< sum_k c_ik x_ik
     std::vector<Vec3> hydrostatic;  ///< sum_k c_ik h_ik x_ik

@@ -17,7 +17,6 @@
 #include "karst/porous/pore_flow.hpp"
 #include "karst/rigid/fragment_motion.hpp"
 #include "karst/sim/watchdog.hpp"
-#include "karst/sph/density.hpp"
 #include "karst/sph/fluid_neighbours.hpp"
 #include "karst/sph/integrate.hpp"
 #include "karst/sph/non_pressure_forces.hpp"
@@ -157,8 +156,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     //    and the per-pair kernel gradient factors that the forces and the pressure solve share.
     timed(profile, Stage::Density, [&] {
         if (porous) update_porous_boundary_volumes(model, state);
-        update_density(model, state);
-        pressure_pair_coefficients(model, state);
+        update_density_and_pair_coefficients(model, state);
     });
     check_scalars(state.fluid.rho, id, Stage::Density, t, "density");
 

@@ -26,7 +26,7 @@ struct PressureSolveReport {
 /// p_i could give back). The divergence solve starts from zero, the density solve from half the
 /// last step's pressure where the fluid would compress (dfsph.cpp says why). Writes state.fluid.p
 /// and p_divergence (Pa) and scratch.a_pressure = a_div + a^p(p) (m/s^2); reads the step's pair
-/// factors (pressure_pair_coefficients).
+/// factors (update_density_and_pair_coefficients).
 PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real dt);
 
 }  // namespace karst

@@ -39,6 +39,19 @@ public:
 
     Vec3 gradient(const Vec3& x) const { return x * dw_over_r(x.norm()); }
 
+    struct ValueAndSlope {
+        Real w, dw_over_r;
+    };
+    /// w(r) and dw_over_r(r) from one q: a pass that needs both per pair computes r once.
+    ValueAndSlope w_and_dw_over_r(Real r) const {
+        const Real q = r * m_inv_h;
+        if (q >= 1) return {0, 0};
+        const Real dq = r <= 1e-9 * m_h ? 0 : m_inv_h / r;
+        if (q <= 0.5) return {m_k * (6 * q * q * q - 6 * q * q + 1), m_l * q * (3 * q - 2) * dq};
+        const Real t = 1 - q;
+        return {2 * m_k * t * t * t, -m_l * t * t * dq};
+    }
+
 private:
     Real m_h, m_inv_h, m_k, m_l;
 };

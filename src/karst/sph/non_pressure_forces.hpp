@@ -6,7 +6,7 @@ namespace karst {
 
 /// Stage (docs/method.md §4.2): gravity, viscosity, Akinci 2013 surface tension (M9) and adhesion
 /// (M10), and Akinci 2012 wall friction, into scratch.a_other (m/s^2). Reads the step's fluid
-/// pair factors (pressure_pair_coefficients) for the kernel gradients.
+/// pair factors (update_density_and_pair_coefficients) for the kernel gradients.
 ///
 /// Viscosity uses the symmetrised Monaghan form
 ///   a_i = (d + 2) nu sum_j m_j (1/rho_i + 1/rho_j) (v_ij . x_ij) / (r^2 + 0.01 h^2) grad W_ij,

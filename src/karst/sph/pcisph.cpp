@@ -40,28 +40,27 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
 /// diverges. Capping keeps the prototype everywhere it is stable (the interior, free surface).
 /// Then under-relaxed by k_pressure_relaxation [D] (sph/pressure_acceleration.hpp says why).
+/// Reads the step's pair factors (update_density_and_pair_coefficients).
 void compute_delta(const Model& model, const State& state, Real dt, std::vector<Real>& delta) {
-    const PorousParticles& porous = state.porous.particles;
-    const std::vector<Real>& psi = state.porous_scratch.psi;
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
-    const CubicKernel& W = model.kernel;
+    const int cap_f = s.fluid_fluid.capacity;
+    const Real rho0_2 = model.rho0 * model.rho0;
     const Real prototype = model.pcisph_delta(dt);
-    const Real scale = model.rho0 * model.rho0 / (2 * dt * dt);
+    const Real scale = rho0_2 / (2 * dt * dt);
     delta.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
-        Vec3 sum_grad = Vec3::Zero();
+        // m_j grad W_ij = rho0^2 c_ij x_ij from the step's pair factors; the boundary's
+        // sum_k Psi_k grad W_ik = rho0^2 sum_k c_ik x_ik is already summed.
+        const Real* c = s.pair_coefficient.data() + i * cap_f;
+        Vec3 sum_grad = rho0_2 * s.boundary_sums.gradient[i];
         Real sum_sq = 0;
+        int k = 0;
         s.fluid_fluid.for_each(i, [&](Index j) {
-            const Vec3 g = f.sph_mass[j] * W.gradient(f.x[i] - f.x[j]);
+            const Vec3 g = (rho0_2 * c[k++]) * (f.x[i] - f.x[j]);
             sum_grad += g;
             sum_sq += g.squaredNorm();
         });
-        s.fluid_wall.for_each(i, [&](Index k) {
-            sum_grad += model.walls.psi[k] * W.gradient(f.x[i] - model.walls.x[k]);
-        });
-        s.fluid_porous.for_each(
-            i, [&](Index k) { sum_grad += psi[k] * W.gradient(f.x[i] - porous.x[k]); });
         const Real denominator = sum_grad.squaredNorm() + sum_sq;
         delta[i] = k_pressure_relaxation *
                    (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);

@@ -10,7 +10,8 @@ namespace karst {
 /// at x*, updates p <- max(p + delta_i (rho* - rho0), 0) (delta_i: M8 per particle, see
 /// pcisph.cpp), and recomputes the pressure acceleration (walls with mirrored pressure), while (it
 /// < it_min or max_i max(rho*_i - rho0, 0) > eta_rho rho0) and it < it_max. Writes state.fluid.p
-/// (Pa) and scratch.a_pressure (m/s^2); reads the step's pair factors (pressure_pair_coefficients).
+/// (Pa) and scratch.a_pressure (m/s^2); reads the step's pair factors
+/// (update_density_and_pair_coefficients).
 PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real dt);
 
 }  // namespace karst

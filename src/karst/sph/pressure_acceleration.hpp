@@ -17,9 +17,10 @@ inline constexpr Real k_pressure_relaxation = 0.5;
 
 /// Per pair, the parts of a_i^p that stay fixed through a step's iterations: m_j / rho0^2 dW/dr / r
 /// (fluid), Psi_k / rho0^2 dW/dr / r and -rho0 g.x_ik (walls, porous). Computed once per step
-/// after the densities (sim/step.cpp), they save a square root, a division and the kernel in
-/// every iteration of either solver and in the viscosity of the non-pressure forces.
-void pressure_pair_coefficients(const Model& model, State& state);
+/// (sim/step.cpp), they save a square root, a division and the kernel in every iteration of
+/// either solver and in the viscosity of the non-pressure forces. The densities of M7
+/// (update_density, sph/density.hpp) come from the same pass: one distance per pair for both.
+void update_density_and_pair_coefficients(const Model& model, State& state);
 
 /// How the pressure of a boundary particle is read in a_i^p.
 enum class BoundaryPressure {
