@@ -38,6 +38,16 @@ TEST(CubicKernel, GradientIntegratesToZeroAndMatchesFiniteDifference) {
     EXPECT_LT(W.gradient(Vec3(0.3 * h, 0, 0))[0], 0);
 }
 
+TEST(CubicKernel, ValueAndSlopeFromOneDistanceAreWAndDwOverR) {
+    const Real h = 0.04;
+    const CubicKernel W(h);
+    for (Real r : {0.0, 1e-12, 0.2 * h, 0.5 * h, 0.5000001 * h, 0.8 * h, h, 1.2 * h}) {
+        const CubicKernel::ValueAndSlope both = W.w_and_dw_over_r(r);
+        EXPECT_EQ(both.w, W.w(r)) << "r/h = " << r / h;
+        EXPECT_EQ(both.dw_over_r, W.dw_over_r(r)) << "r/h = " << r / h;
+    }
+}
+
 TEST(SpikyKernel, M1IntegratesToOneWithNegativeGradient) {
     const Real h = 0.04;
     const SpikyKernel W(h);

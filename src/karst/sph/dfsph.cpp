@@ -20,7 +20,7 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0, scale = dt * dt / rho0_2;
-    const int cap_f = s.fluid_fluid.capacity, cap_p = s.fluid_porous.capacity;
+    const int cap_p = s.fluid_porous.capacity;
     const PorousParticles& porous = state.porous.particles;
     const std::vector<Fragment>& fragments = state.porous.fragments;
     std::vector<Mat3> inverse_inertia(fragments.size(), Mat3::Zero());
@@ -30,18 +30,10 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
     s.diagonal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         const Vec3 xi = f.x[i];
-        Vec3 fluid = Vec3::Zero();
+        const FluidGradientSums fluid = fluid_gradient_sums(model, state, i);
         const Vec3 boundary = rho0_2 * s.boundary_sums.gradient[i];  // sum_k Psi_k grad W_ik
-        Real squares = 0;
-        const Real* cf = s.pair_coefficient.data() + i * cap_f;
-        int k = 0;
-        s.fluid_fluid.for_each(i, [&](Index j) {
-            const Vec3 g = (rho0_2 * cf[k++]) * (xi - f.x[j]);  // m_j grad W_ij
-            fluid += g;
-            squares += g.squaredNorm();
-        });
         const Real* cp = s.porous_coefficient.data() + i * cap_p;
-        k = 0;
+        int k = 0;
         // The free fragments touched, in list order (a particle touches one or two).
         Index touched[4];
         Vec3 push[4], turn[4];
@@ -65,8 +57,8 @@ void compute_diagonal(const Model& model, State& state, Real dt) {
                         turn[slot].dot(inverse_inertia[touched[slot]] * turn[slot]);
         // sum_j m_i m_j |grad W_ij|^2, read as (m_i / m_0) sum_j |m_j grad W_ij|^2 (equal for
         // water).
-        const Real own = (fluid + 2 * boundary).squaredNorm();
-        s.diagonal[i] = scale * (own + squares * f.sph_mass[i] / model.particle_mass +
+        const Real own = (fluid.sum + 2 * boundary).squaredNorm();
+        s.diagonal[i] = scale * (own + fluid.squares * f.sph_mass[i] / model.particle_mass +
                                  f.sph_mass[i] * mobility);
     });
 }

@@ -44,24 +44,15 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 void compute_delta(const Model& model, const State& state, Real dt, std::vector<Real>& delta) {
     const FluidParticles& f = state.fluid;
     const FluidScratch& s = state.scratch;
-    const int cap_f = s.fluid_fluid.capacity;
     const Real rho0_2 = model.rho0 * model.rho0;
     const Real prototype = model.pcisph_delta(dt);
     const Real scale = rho0_2 / (2 * dt * dt);
     delta.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
-        // m_j grad W_ij = rho0^2 c_ij x_ij from the step's pair factors; the boundary's
-        // sum_k Psi_k grad W_ik = rho0^2 sum_k c_ik x_ik is already summed.
-        const Real* c = s.pair_coefficient.data() + i * cap_f;
-        Vec3 sum_grad = rho0_2 * s.boundary_sums.gradient[i];
-        Real sum_sq = 0;
-        int k = 0;
-        s.fluid_fluid.for_each(i, [&](Index j) {
-            const Vec3 g = (rho0_2 * c[k++]) * (f.x[i] - f.x[j]);
-            sum_grad += g;
-            sum_sq += g.squaredNorm();
-        });
-        const Real denominator = sum_grad.squaredNorm() + sum_sq;
+        // The boundary's sum_k Psi_k grad W_ik = rho0^2 sum_k c_ik x_ik is summed once a step.
+        const FluidGradientSums fluid = fluid_gradient_sums(model, state, i);
+        const Real denominator =
+            (fluid.sum + rho0_2 * s.boundary_sums.gradient[i]).squaredNorm() + fluid.squares;
         delta[i] = k_pressure_relaxation *
                    (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
     });

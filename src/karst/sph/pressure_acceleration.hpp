@@ -22,6 +22,28 @@ inline constexpr Real k_pressure_relaxation = 0.5;
 /// (update_density, sph/density.hpp) come from the same pass: one distance per pair for both.
 void update_density_and_pair_coefficients(const Model& model, State& state);
 
+/// Over the fluid neighbours j of i, from the step's pair factors (m_j grad W_ij = rho0^2 c_ij
+/// x_ij): sum_j m_j grad W_ij and sum_j |m_j grad W_ij|^2, the fluid's parts of both solvers'
+/// diagonals (M8's delta_i, DFSPH's -d rho*_i / d p_i).
+struct FluidGradientSums {
+    Vec3 sum = Vec3::Zero();  ///< kg/m^4
+    Real squares = 0;         ///< kg^2/m^8
+};
+inline FluidGradientSums fluid_gradient_sums(const Model& model, const State& state, Index i) {
+    const FluidParticles& f = state.fluid;
+    const FluidScratch& s = state.scratch;
+    const Real rho0_2 = model.rho0 * model.rho0;
+    const Real* c = s.pair_coefficient.data() + i * s.fluid_fluid.capacity;
+    FluidGradientSums sums;
+    int k = 0;
+    s.fluid_fluid.for_each(i, [&](Index j) {
+        const Vec3 g = (rho0_2 * c[k++]) * (f.x[i] - f.x[j]);
+        sums.sum += g;
+        sums.squares += g.squaredNorm();
+    });
+    return sums;
+}
+
 /// How the pressure of a boundary particle is read in a_i^p.
 enum class BoundaryPressure {
     Hydrostatic,  ///< p_ik = max(p_i - rho0 g.x_ik, 0): the density solve (pcisph.cpp says why)
