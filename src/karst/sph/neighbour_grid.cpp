@@ -67,7 +67,10 @@ void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
             const Vec3 xi = queries[i];
             const auto c = grid.coords(xi);
             const int x0 = std::max(c[0] - 1, 0), x1 = std::min(c[0] + 1, grid.dims[0] - 1);
-            std::uint32_t* list = out.index.data() + i * cap;
+            // Every candidate is written and the count advanced by the test: within h or not
+            // is a coin toss per candidate, and a branch on it mispredicts often.
+            thread_local std::vector<std::uint32_t> found;
+            const std::uint32_t self = exclude_self ? std::uint32_t(i) : ~std::uint32_t(0);
             int k = 0;
             for (int dz = -1; dz <= 1; ++dz) {
                 const int z = c[2] + dz;
@@ -78,15 +81,16 @@ void find_neighbours(const UniformGrid& grid, const std::vector<Vec3>& queries,
                     // Cells x0..x1 of one row are consecutive, so their particles are one range.
                     const std::uint32_t b = targets.start[grid.linear({x0, y, z})];
                     const std::uint32_t e = targets.start[grid.linear({x1, y, z}) + 1];
+                    if (found.size() < size_t(k) + (e - b)) found.resize(2 * (size_t(k) + (e - b)));
+                    std::uint32_t* into = found.data();
                     for (std::uint32_t s = b; s < e; ++s) {
-                        if ((targets.sorted_x[s] - xi).squaredNorm() >= h2) continue;
                         const std::uint32_t j = targets.order[s];
-                        if (exclude_self && Index(j) == i) continue;
-                        if (k < cap) list[k] = j;
-                        ++k;
+                        into[k] = j;
+                        k += int((targets.sorted_x[s] - xi).squaredNorm() < h2) & int(j != self);
                     }
                 }
             }
+            std::copy_n(found.data(), std::min(k, cap), out.index.data() + i * cap);
             out.count[i] = std::uint16_t(std::min(k, cap));
             if (k > cap) {
                 int m = most.load();
