@@ -57,6 +57,116 @@ TEST(PoroelasticScene, ShippedTerzaghiSceneConsolidatesLikeTheSeries) {
               std::lround(t_end / sim.model.scene.poroelastic.time_step));
 }
 
+/// Mandel's problem (Cheng & Detournay 1988; parameters after MOOSE's mandel.i, made less
+/// compressible for a clearer Mandel-Cryer effect): a plane-strain slab of half-width a pressed
+/// by rigid frictionless impermeable platens with the force per unit length F, its sides drained.
+/// The pore pressure at distance x from the mid-plane, with p0 = F B (1 + nu_u) / (3 a):
+///   p = 2 p0 sum_n s_n (cos(a_n x / a) - cos a_n) e_n,
+///   s_n = sin a_n / (a_n - sin a_n cos a_n), e_n = exp(-a_n^2 c t / a^2),
+///   tan a_n = (1 - nu) / (nu_u - nu) a_n,
+///   c = 2 kappa B^2 G (1 - nu) (1 + nu_u)^2 / (9 (1 - nu_u) (nu_u - nu)),
+/// and the platen's settlement per unit height
+///   u_z / z = -F (1 - nu) / (2 G a) + F (1 - nu_u) / (G a) sum_n s_n cos a_n e_n,
+/// from undrained (1 - nu_u) to drained (1 - nu).
+struct MandelSolution {
+    Real a, p0, c, drained_strain, relief;  ///< relief: F (1 - nu_u) / (G a)
+    std::vector<Real> roots;
+    MandelSolution(Real E, Real nu, Real porosity, Real biot, Real K_f, Real mobility, Real a_,
+                   Real stress)
+        : a(a_) {
+        const Real K = E / (3 * (1 - 2 * nu)), G = E / (2 * (1 + nu)), K_s = K / (1 - biot);
+        const Real M = 1 / (porosity / K_f + (biot - porosity) / K_s), K_u = K + biot * biot * M;
+        const Real B = biot * M / K_u, nu_u = (3 * K_u - 2 * G) / (2 * (3 * K_u + G));
+        const Real F = stress * a;
+        p0 = F * B * (1 + nu_u) / (3 * a);
+        drained_strain = -F * (1 - nu) / (2 * G * a), relief = F * (1 - nu_u) / (G * a);
+        c = 2 * mobility * B * B * G * (1 - nu) * (1 + nu_u) * (1 + nu_u) /
+            (9 * (1 - nu_u) * (nu_u - nu));
+        // Root n lies in ((n - 1) pi, (n - 1) pi + pi / 2): bisection on sin - k a cos.
+        const Real k = (1 - nu) / (nu_u - nu), pi = std::numbers::pi;
+        for (int n = 1; n <= 200; ++n) {
+            Real lo = (n - 1) * pi + 1e-12, hi = (n - 1) * pi + pi / 2;
+            auto f = [&](Real r) { return std::sin(r) - k * r * std::cos(r); };
+            const bool lo_positive = f(lo) > 0;
+            for (int it = 0; it < 100; ++it) {
+                const Real mid = 0.5 * (lo + hi);
+                ((f(mid) > 0) == lo_positive ? lo : hi) = mid;
+            }
+            roots.push_back(0.5 * (lo + hi));
+        }
+    }
+    Real pressure(Real x, Real t) const {
+        Real sum = 0;
+        for (const Real r : roots)
+            sum += std::sin(r) / (r - std::sin(r) * std::cos(r)) *
+                   (std::cos(r * x / a) - std::cos(r)) * std::exp(-r * r * c * t / (a * a));
+        return 2 * p0 * sum;
+    }
+    Real vertical_strain(Real t) const {
+        Real sum = 0;
+        for (const Real r : roots)
+            sum += std::sin(r) * std::cos(r) / (r - std::sin(r) * std::cos(r)) *
+                   std::exp(-r * r * c * t / (a * a));
+        return drained_strain + relief * sum;
+    }
+};
+
+TEST(PoroelasticScene, MandelsProblemShowsTheMandelCryerRiseAndDecaysLikeTheSeries) {
+    // The quarter slab: x from the mid-plane (held in x, no flow) to the drained side at x = 1 m,
+    // z from the base (held in z) to the rigid platen; plane strain by holding both y faces.
+    // The nodes sit dx / 2 inside the box, so the slab's half-width is 0.95 m and the platen's
+    // area 0.95 x 0.05 m^2; its force gives a mean stress of 1 Pa.
+    const Real a = 0.95, x0 = 0.025, stress = 1, force = stress * a * 0.05;
+    test::Simulation sim(fmt::format(R"({{
+      "name": "mandel", "particle_spacing": 0.05, "gravity": [0, 0, 0],
+      "poroelastic": {{ "time_step": 0.0025, "fluid_bulk_modulus": 100, "permeability_feedback": false,
+                        "pressure_source": "biot" }},
+      "porous_solids": [ {{ "shape": {{ "type": "box", "min": [0, 0, 0], "max": [1, 0.1, 0.2] }},
+        "material": {{ "porosity": 0.1, "permeability": 1.5e-4, "darcy_viscosity": 1e-4, "youngs_modulus": 1.8,
+                       "poisson_ratio": 0.1, "biot_coefficient": 0.9, "solid_density": 2000 }},
+        "constraints": [
+          {{ "kind": "fixed", "axes": "x", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [0, 2, 2] }} }},
+          {{ "kind": "fixed", "axes": "y", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 0, 2] }} }},
+          {{ "kind": "fixed", "axes": "y", "region": {{ "type": "box", "min": [-1, 0.1, -1], "max": [2, 2, 2] }} }},
+          {{ "kind": "fixed", "axes": "z", "region": {{ "type": "box", "min": [-1, -1, -1], "max": [2, 2, 0] }} }},
+          {{ "kind": "drained", "pressure": 0, "region": {{ "type": "box", "min": [1, -1, -1], "max": [2, 2, 2] }} }},
+          {{ "kind": "platen", "axes": "z", "force": {}, "region": {{ "type": "box", "min": [-1, -1, 0.2], "max": [2, 2, 2] }} }} ] }} ]
+    }})",
+                                     -force));
+    const MandelSolution exact(1.8, 0.1, 0.1, 0.9, 100, 1.5e-4 / 1e-4, a, stress);
+    const Structure& s = sim.state.structures.structures.at(0);
+    auto mid_plane_pressure = [&] {
+        Real sum = 0;
+        int n = 0;
+        for (Index i = 0; i < s.mesh.node_count(); ++i)
+            if (s.mesh.nodes[i].x() < x0 + 1e-9) sum += s.fields.p[i], ++n;
+        return sum / n;
+    };
+    // The mid-plane pressure first rises over the undrained p0 as the drained sides soften and
+    // hand their load to the core (the Mandel-Cryer effect, 1.111 p0 at c t / a^2 = 0.07 here),
+    // which an uncoupled diffusion of p cannot give; then it decays.
+    Real highest = 0;
+    for (const Real t : {0.0025, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2}) {
+        sim.run_until(t - 1e-9, [&] { highest = std::max(highest, mid_plane_pressure()); });
+        const Real now = sim.state.time;
+        Real err2 = 0, ref2 = 0, settlement = 0;
+        for (Index i = 0; i < s.mesh.node_count(); ++i) {
+            const Real e = exact.pressure(s.mesh.nodes[i].x() - x0, now);
+            err2 += std::pow(s.fields.p[i] - e, 2), ref2 += e * e;
+            if (s.mesh.nodes[i].z() > 0.17) settlement = s.fields.u[i].z();
+        }
+        EXPECT_LT(std::sqrt(err2 / ref2), now < 0.01 ? 0.05 : 0.02) << "L2 error at t = " << now;
+        EXPECT_NEAR(mid_plane_pressure(), exact.pressure(0, now), 0.015 * exact.p0)
+            << "t = " << now;
+        // Between the base and platen node layers, 0.15 m apart.
+        EXPECT_NEAR(settlement, 0.15 * exact.vertical_strain(now),
+                    0.01 * 0.15 * std::abs(exact.drained_strain))
+            << "t = " << now;
+    }
+    EXPECT_GT(highest, 1.08 * exact.p0);
+    EXPECT_LT(highest, 1.13 * exact.p0);
+}
+
 TEST(PoroelasticScene, CompactionLowersPermeabilityByKozenyCarman) {
     // A drained, laterally confined block pressed from the top by 0.1 MPa: uniform strain
     // eps_zz = -q / (lambda + 2 mu), so M23 and M24 give one permeability for every tet.
