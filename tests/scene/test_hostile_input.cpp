@@ -107,6 +107,26 @@ TEST(HostileInput, StepAndFrameCountsAreBounded) {
         "/output/fps");
 }
 
+TEST(HostileInput, AViscosityTheExplicitStepCannotCarryIsRefused) {
+    // At dx 0.05 the stable step is 0.05 dx^2 / nu_eff (sph/integrate.hpp): 1.25e-4 s for nu = 1.
+    EXPECT_EQ(test::refuse_scene(
+                  fluid_scene(k_box, R"(,"fluid":{"viscosity":1},"time":{"fixed_dt":1e-3})"))
+                  .path,
+              "/time/fixed_dt");
+    EXPECT_EQ(
+        test::refuse_scene(fluid_scene(k_box, R"(,"fluid":{"viscosity":1},"time":{"dt_min":1e-3})"))
+            .path,
+        "/fluid/viscosity");
+    EXPECT_EQ(test::refuse_scene(
+                  fluid_scene(k_box, R"(,"fluid":{"artificial_viscosity":1,"sound_speed":10000},)"
+                                     R"("time":{"dt_min":1e-5})"))
+                  .path,
+              "/fluid/artificial_viscosity");
+    EXPECT_NO_THROW(build_model(parse_scene(
+        fluid_scene(k_box, R"(,"fluid":{"viscosity":0.01},"time":{"fixed_dt":1e-3})"))));
+    EXPECT_NO_THROW(build_model(parse_scene(fluid_scene(k_box, R"(,"fluid":{"viscosity":1})"))));
+}
+
 TEST(HostileInput, AConstraintOrWetRegionThatSelectsNoParticleIsRefused) {
     const std::string far = R"({"type": "box", "min": [5,5,5], "max": [6,6,6]})";
     const std::string block = R"({"name":"t","particle_spacing":0.1,"porous_solids": [{

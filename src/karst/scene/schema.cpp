@@ -68,7 +68,9 @@ std::vector<KeySpec> make_schema() {
         key("/fluid/rest_density", T::Number, "kg/m^3", closed(100, 20000), 1000.0,
             "Rest density rho0."),
         key("/fluid/viscosity", T::Number, "m^2/s", closed(0, 1.0), 1e-6,
-            "Kinematic viscosity nu (docs/method.md §4.2)."),
+            "Kinematic viscosity nu (docs/method.md §4.2). Explicit: the step stays below 0.05 "
+            "dx^2 / nu (with the artificial viscosity's share, M11), so a large nu takes short "
+            "steps; a fixed_dt above that, or a bound under dt_min, is refused."),
         key("/fluid/artificial_viscosity", T::Number, "", closed(0, 1), 0.01,
             "alpha_v of the Becker-Teschner artificial viscosity (docs/method.md §4.2), acting "
             "only "
@@ -91,7 +93,7 @@ std::vector<KeySpec> make_schema() {
             "the expected speed)."),
         key("/fluid/solute_diffusivity", T::Number, "m^2/s", closed(0, 1), 1e-4,
             "Diffusivity D of the solute among fluid particles (M18; scene-scaled, docs/method.md "
-            "§8.2)."),
+            "§8.2). Explicit, in sub-steps of at most 0.15 dx^2 / D."),
         key("/fluid/solver", T::Enum, "", any(), "dfsph",
             "Pressure solver. dfsph: divergence-free SPH (Bender & Koschier 2017), a "
             "velocity-level solve "

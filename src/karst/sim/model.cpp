@@ -4,6 +4,7 @@
 #include "karst/porous/permeability.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/porous_materials.hpp"
+#include "karst/sph/integrate.hpp"
 
 #include <fmt/format.h>
 
@@ -153,6 +154,30 @@ void check_step_counts(const Scene& s) {
             fmt::format("at most {:g} frames over the {:g} s run", k_max_frames, end),
             fmt::format("{:g} per second, {:.3g} frames", s.output.fps, end * s.output.fps));
     if (!s.porous_solids.empty()) check(s.poroelastic.time_step, "/poroelastic/time_step");
+}
+
+/// A viscosity the explicit step cannot carry (sph/integrate.hpp, viscous_step_limit) is refused
+/// before simulating: a fixed step above its bound, or a bound below dt_min.
+void check_viscous_step(const Scene& s) {
+    const Real limit = viscous_step_limit(s.fluid, s.particle_spacing);
+    if (s.time.fixed_dt && std::min(*s.time.fixed_dt, s.time.end) > limit)
+        throw SceneError("/time/fixed_dt",
+                         fmt::format("a step of at most {:.3g} s, the stable step {:g} dx^2 / nu "
+                                     "for this viscosity and spacing",
+                                     limit, k_viscous_step),
+                         fmt::format("{:.3g} s", *s.time.fixed_dt));
+    if (!s.time.fixed_dt && limit < s.time.dt_min) {
+        const bool physical =
+            s.fluid.viscosity >= artificial_kinematic_viscosity(s.fluid, s.particle_spacing);
+        throw SceneError(
+            physical ? "/fluid/viscosity" : "/fluid/artificial_viscosity",
+            fmt::format("a viscosity whose stable step, {:g} dx^2 / nu, is at least /time/dt_min "
+                        "= {:.3g} s (or a coarser spacing)",
+                        k_viscous_step, s.time.dt_min),
+            fmt::format("nu = {:g} m^2/s, alpha_v = {:g}, c_s = {:g} m/s: a step of {:.3g} s",
+                        s.fluid.viscosity, s.fluid.artificial_viscosity, s.fluid.sound_speed,
+                        limit));
+    }
 }
 
 /// Fluid blocks and porous solids on the scene lattice; no lattice site may be taken twice.
@@ -382,6 +407,7 @@ Model build_model(const Scene& scene) {
     check_step_counts(scene);
     check_particle_budget(scene);
     sample_fluid_and_solids(scene, m);
+    if (!m.initial_x.empty() || m.coupled()) check_viscous_step(scene);
     std::vector<int> wall_layers;  // per wall particle
     sample_walls(scene, m, wall_layers);
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace karst {
 
@@ -43,6 +44,16 @@ void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool c
         state.dt_solver_limit *= 1.1;
 }
 
+Real artificial_kinematic_viscosity(const FluidSettings& fluid, Real dx) {
+    const Real h = 2 * dx;  // the support radius, as Model::h
+    return fluid.artificial_viscosity * h * fluid.sound_speed / 20;
+}
+
+Real viscous_step_limit(const FluidSettings& fluid, Real dx) {
+    const Real nu = fluid.viscosity + artificial_kinematic_viscosity(fluid, dx);
+    return nu > 0 ? k_viscous_step * dx * dx / nu : std::numeric_limits<Real>::infinity();
+}
+
 Real cfl_time_step(const Model& model, const State& state) {
     const TimeSettings& t = model.scene.time;
     if (t.fixed_dt) return *t.fixed_dt;
@@ -51,7 +62,7 @@ Real cfl_time_step(const Model& model, const State& state) {
     const Real v_max = std::sqrt(
         std::max(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }),
                  parallel_max(p.size(), 0.0, [&](Index i) { return p.v[i].squaredNorm(); })));
-    Real dt = t.dt_max;
+    Real dt = std::min(t.dt_max, viscous_step_limit(model.scene.fluid, model.dx));
     if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
     if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));
     const Real p_max = parallel_max(f.size(), 0.0, [&](Index i) { return f.p[i]; });

@@ -16,7 +16,8 @@ void diffuse_solute(const Model& model, State& state, Real dt) {
 
     const CubicKernel& W = model.kernel;
     const Real eps = 0.01 * model.h * model.h;
-    const int substeps = std::max(1, int(std::ceil(dt / (0.1 * model.h * model.h / D))));
+    const int substeps =
+        std::max(1, int(std::ceil(dt / (k_diffusion_substep * model.dx * model.dx / D))));
     const Real h_sub = dt / substeps;
     std::vector<Real> concentration(n), rate(n);
     for (int s = 0; s < substeps; ++s) {

@@ -6,8 +6,13 @@
 
 namespace karst {
 
-/// Diffuses solute over dt (sub-stepped at 0.1 h^2 / D), reading the densities and fluid
-/// neighbour lists of this step. Does nothing when D = 0 or no particle carries solute.
+/// [D] The explicit sub-step of the diffusion, times dx^2 / D. Measured with a fixed step: stable
+/// at 0.35, concentrations of 1e7 at 0.375; the sub-step of 0.1 h^2 / D = 0.4 dx^2 / D it
+/// replaces let D >= 0.2 m^2/s at dx 0.02 diverge to infinities (bench/results/notes.md).
+inline constexpr Real k_diffusion_substep = 0.15;
+
+/// Diffuses solute over dt (sub-stepped at k_diffusion_substep dx^2 / D), reading the densities
+/// and fluid neighbour lists of this step. Does nothing when D = 0 or no particle carries solute.
 void diffuse_solute(const Model& model, State& state, Real dt);
 
 }  // namespace karst
