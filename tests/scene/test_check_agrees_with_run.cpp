@@ -74,6 +74,10 @@ TEST(CheckAgreesWithRun, EveryRunTimeRefusalIsRefusedByCheckWithTheSamePath) {
         {coupled_scene(block(soil, std::string(", ") + k_fixed_base),
                        R"( "poroelastic": { "coupled_fragments": "none" },)"),
          "/porous_solids/0/constraints"},
+        // A viscosity whose stable explicit step lies under dt_min.
+        {replaced(coupled_scene(block(soil), R"( "fluid": { "viscosity": 1 },)"), "\"end\": 0.01 }",
+                  "\"end\": 0.01, \"dt_min\": 1e-3 }"),
+         "/fluid/viscosity"},
         // Geometry and schema refusals, for completeness.
         {coupled_scene(block(soil), R"( "domain": { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] },)"),
          "/domain"},

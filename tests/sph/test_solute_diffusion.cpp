@@ -76,6 +76,10 @@ TEST(SoluteDiffusion, TheLargestDiffusivityKeepsEveryConcentrationWithinItsStart
     EXPECT_GE(lowest, 0.0);
     EXPECT_LE(highest, 1.0);
     EXPECT_GT(lowest, 0.1) << "at D t = 0.05 m^2 the two halves have nearly mixed";
+    // A step that would need more than k_max_diffusion_substeps is not taken (the run stops).
+    const std::vector<Real> kept = f.solute;
+    EXPECT_GT(diffuse_solute(sim.model, sim.state, 1.0), k_max_diffusion_substeps);
+    EXPECT_EQ(f.solute, kept);
 }
 
 TEST(SoluteDiffusion, SoluteIsConservedInAMovingFlow) {

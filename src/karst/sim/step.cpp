@@ -188,7 +188,15 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     update_solver_time_step_limit(state, dt, dt < dt_wanted, converged, model.scene.time.dt_max);
 
     // 10. Solute diffusion among fluid particles (M18), on this step's densities and lists.
-    timed(profile, Stage::SoluteDiffusion, [&] { diffuse_solute(model, state, dt); });
+    timed(profile, Stage::SoluteDiffusion, [&] {
+        if (const Real needed = diffuse_solute(model, state, dt); needed > 0)
+            throw WatchdogError(
+                k_stage_names[size_t(Stage::SoluteDiffusion)], state.time,
+                fmt::format("the solute diffusion needs {:.3g} explicit sub-steps in a step of "
+                            "{:.3g} s (at most {:g}): lower /fluid/solute_diffusivity or "
+                            "/time/dt_max, or raise particle_spacing",
+                            needed, dt, k_max_diffusion_substeps));
+    });
     check_scalars(state.fluid.solute, id, Stage::SoluteDiffusion, t, "solute mass");
 
     if (porous) {

@@ -62,7 +62,8 @@ Real cfl_time_step(const Model& model, const State& state) {
     const Real v_max = std::sqrt(
         std::max(parallel_max(f.size(), 0.0, [&](Index i) { return f.v[i].squaredNorm(); }),
                  parallel_max(p.size(), 0.0, [&](Index i) { return p.v[i].squaredNorm(); })));
-    Real dt = std::min(t.dt_max, viscous_step_limit(model.scene.fluid, model.dx));
+    Real dt = t.dt_max;
+    if (f.size() > 0) dt = std::min(dt, viscous_step_limit(model.scene.fluid, model.dx));
     if (v_max > 0) dt = std::min(dt, t.cfl * model.dx / v_max);
     if (state.a_max > 0) dt = std::min(dt, 0.25 * std::sqrt(model.dx / state.a_max));
     const Real p_max = parallel_max(f.size(), 0.0, [&](Index i) { return f.p[i]; });

@@ -31,24 +31,27 @@ void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool c
                                    Real dt_max);
 
 /// [D] The viscous terms are explicit, so a step is stable only below k_viscous_step dx^2 /
-/// nu_eff, nu_eff = nu + artificial_kinematic_viscosity. Measured: above about 0.11 dx^2 / nu
-/// (dx 0.01 and 0.02; Morris et al. 1997 give 0.125 h^2 / nu for a smoothing length h = dx) a
-/// tank gained energy tenfold in a few steps; 0.05 keeps a factor of two (bench/results/
-/// notes.md). Wall friction is left out: it only brakes approach to a resting wall, and held at
-/// sigma_f = 8 with a 1 ms step. Infinite without viscosity.
+/// nu_eff, nu_eff = nu + artificial_kinematic_viscosity. Measured at a fixed 1 ms step (dx 0.01
+/// and 0.02): stable up to 0.11 dx^2 / nu; at 0.125 the energy of a collapsing block rose 1.3 to
+/// 4 times within 0.5 s, at 0.1375 35 times (Morris et al. 1997 give 0.125 l^2 / nu for a
+/// smoothing length l = dx). 0.05 keeps a factor of two (bench/results/notes.md). Wall friction
+/// is left out: it only brakes approach to a resting wall, and held at sigma_f = 8 with a 1 ms
+/// step. Infinite without viscosity.
 inline constexpr Real k_viscous_step = 0.05;
 Real viscous_step_limit(const FluidSettings& fluid, Real dx);
 
-/// The artificial viscosity's share of nu_eff, alpha_v h c_s / 20, m^2/s: its pair term is that
-/// of nu = alpha_v h c_s / (2 (d + 2)) (sph/non_pressure_forces.cpp), but it acts on approaching
-/// pairs only and held to about twice that.
+/// The artificial viscosity's share of nu_eff, alpha_v h c_s / 20, m^2/s (h the support radius).
+/// Its pair term equals the viscosity's for nu = alpha_v h c_s / (2 (d + 2))
+/// (sph/non_pressure_forces.cpp), but it acts on approaching pairs only, and in a collapsing
+/// block it was stable to about twice that nu (alpha_v c_s = 20 m/s held at 1 ms and dx 0.02,
+/// 32 m/s diverged).
 Real artificial_kinematic_viscosity(const FluidSettings& fluid, Real dx);
 
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max), dt_max), or the scene's fixed step
 /// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now;
 /// a_max that of the last step; also at most the pressure solve's bound
 /// (update_solver_time_step_limit), 0.5 dx sqrt(rho0 / p_max) and viscous_step_limit.
-/// [D] The last bound: the pressure force's geometric stiffness, about p / (rho0 dx^2) per unit
+/// [D] The p_max bound: the pressure force's geometric stiffness, about p / (rho0 dx^2) per unit
 /// mass, is integrated explicitly (a particle that moves changes the force the pressure gives
 /// it), and deep water at the M11 step rang up (a 1 m column at dx 0.01 stopped on the watchdog
 /// at t = 1.2 s; with the bound it comes to rest, bench/results/notes.md).

@@ -6,18 +6,19 @@
 
 namespace karst {
 
-void diffuse_solute(const Model& model, State& state, Real dt) {
+Real diffuse_solute(const Model& model, State& state, Real dt) {
     FluidParticles& f = state.fluid;
     const Real D = model.scene.fluid.solute_diffusivity;
     const Index n = f.size();
-    if (D <= 0 || n == 0) return;
+    if (D <= 0 || n == 0) return 0;
     const bool any = parallel_max(n, Real(0), [&](Index i) { return f.solute[i]; }) > 0;
-    if (!any) return;
+    if (!any) return 0;
 
     const CubicKernel& W = model.kernel;
     const Real eps = 0.01 * model.h * model.h;
-    const int substeps =
-        std::max(1, int(std::ceil(dt / (k_diffusion_substep * model.dx * model.dx / D))));
+    const Real needed = std::ceil(dt / (k_diffusion_substep * model.dx * model.dx / D));
+    if (needed > k_max_diffusion_substeps) return needed;
+    const int substeps = std::max(1, int(needed));
     const Real h_sub = dt / substeps;
     std::vector<Real> concentration(n), rate(n);
     for (int s = 0; s < substeps; ++s) {
@@ -43,6 +44,7 @@ void diffuse_solute(const Model& model, State& state, Real dt) {
         });
         parallel_for(n, [&](Index i) { f.solute[i] += h_sub * rate[i]; });
     }
+    return 0;
 }
 
 }  // namespace karst
