@@ -90,7 +90,9 @@ std::vector<KeySpec> make_schema() {
             "Akinci 2012 fluid-wall friction coefficient sigma_f; 0 gives free slip."),
         key("/fluid/sound_speed", T::Number, "m/s", positive(1e4), 20.0,
             "Numerical sound speed c_s used by wall friction and artificial viscosity (about 10x "
-            "the expected speed)."),
+            "the expected speed). A step shorter than dx / c_s is held to the share dt c_s / dx "
+            "of the pressure solves' bands and removes that share of a compression "
+            "(docs/method.md §4.3)."),
         key("/fluid/solute_diffusivity", T::Number, "m^2/s", closed(0, 1), 1e-4,
             "Diffusivity D of the solute among fluid particles (M18; scene-scaled, docs/method.md "
             "§8.2). Explicit, in sub-steps of at most 0.15 dx^2 / D."),
@@ -106,12 +108,11 @@ std::vector<KeySpec> make_schema() {
             {"dfsph", "pcisph"}),
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
             "The pressure solve stops when the largest predicted compression is below this "
-            "fraction of "
-            "rho0."),
+            "fraction of rho0 (times dt c_s / dx in a step shorter than dx / c_s)."),
         key("/fluid/max_divergence_error", T::Number, "", closed(1e-6, 0.1), 0.01,
             "DFSPH's divergence solve stops when no particle at or above rho0 would compress by "
-            "more "
-            "than this fraction of rho0 over the step."),
+            "more than this fraction of rho0 over the step (times dt c_s / dx in a step shorter "
+            "than dx / c_s)."),
         key("/fluid/min_iterations", T::Integer, "", closed(1, 100), 3,
             "PCISPH minimum predictor-corrector iterations (DFSPH, warm-started, stops as soon as "
             "it "

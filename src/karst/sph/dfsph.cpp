@@ -2,6 +2,7 @@
 
 #include "karst/core/parallel.hpp"
 #include "karst/coupling/fragment_response.hpp"
+#include "karst/sph/integrate.hpp"
 #include "karst/sph/pressure_acceleration.hpp"
 
 #include <algorithm>
@@ -151,6 +152,9 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     const Index n = f.size();
     const FluidSettings& fs = model.scene.fluid;
     const Real rho0 = model.rho0;
+    // The tolerances and the density target as rates: a step of the share `rate` of the sound's
+    // crossing time may compress or relax that share of what a whole one may (sph/integrate.hpp).
+    const Real rate = solve_rate_fraction(fs, model.dx, dt);
     compute_diagonal(model, state, dt);
     s.v_pred.resize(n), s.rho_err.resize(n), s.a_divergence.resize(n), s.a_pressure.resize(n);
 
@@ -162,7 +166,7 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
     const FragmentResponse still(model, state, dt, false, nullptr);
     const SolveResult div = relax(
         model, state, dt, f.p_divergence, f.v, BoundaryPressure::Mirrored, still, s.a_divergence,
-        [&](Index i) { return std::max(f.rho[i], rho0); }, fs.max_divergence_error,
+        [&](Index i) { return std::max(f.rho[i], rho0); }, rate * fs.max_divergence_error,
         fs.max_iterations);
     report.divergence_iterations = div.iterations;
 
@@ -180,16 +184,20 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
                                   BoundaryPressure::Hydrostatic, s.porous_v_pred);
     else
         s.porous_v_pred = state.porous.particles.v;
+    // The target: rho0, or the share `rate` of the way there from a compressed density.
+    const auto target = [&](Index i) {
+        return std::max(rho0, f.rho[i] - rate * (f.rho[i] - rho0));
+    };
     parallel_for(n, [&](Index i) {
         const bool compressed =
-            f.rho[i] + density_change(model, state, base, s.porous_v_pred, i, dt) > rho0;
+            f.rho[i] + density_change(model, state, base, s.porous_v_pred, i, dt) > target(i);
         f.p[i] = compressed ? 0.5 * f.p[i] : 0;
     });
-    const SolveResult density = relax(
-        model, state, dt, f.p, base, BoundaryPressure::Hydrostatic, falling, s.a_pressure,
-        [&](Index) { return rho0; }, fs.max_density_error, fs.max_iterations);
+    const SolveResult density =
+        relax(model, state, dt, f.p, base, BoundaryPressure::Hydrostatic, falling, s.a_pressure,
+              target, rate * fs.max_density_error, fs.max_iterations);
     report.iterations = density.iterations;
-    report.max_density_error = density.max_error;
+    report.max_density_error = density.max_error / rate;
     parallel_for(n, [&](Index i) { s.a_pressure[i] += s.a_divergence[i]; });
     return report;
 }

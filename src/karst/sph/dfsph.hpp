@@ -7,8 +7,11 @@ namespace karst {
 struct PressureSolveReport {
     int iterations = 0;             ///< density-solve iterations (PCISPH: predictor-corrector)
     int divergence_iterations = 0;  ///< DFSPH divergence-solve iterations; 0 for PCISPH
-    Real max_density_error =
-        0;  ///< largest predicted compression max_i (rho*_i - rho0) / rho0 at the end
+    /// The density solve's last residual over solve_rate_fraction (sph/integrate.hpp), a
+    /// fraction of rho0: the predicted compression beyond the target, or the over-pressure a
+    /// particle could give back where the fluid expands. At most /fluid/max_density_error once
+    /// converged.
+    Real max_density_error = 0;
 };
 
 /// Stage (docs/method.md §4.3, replaced): divergence-free SPH after Bender & Koschier 2017, with
@@ -22,6 +25,7 @@ struct PressureSolveReport {
 /// 1. divergence: v* = v + dt a^p(p_div), until no particle at or above rho0 is compressed
 ///    further (rho*_i <= max(rho_i, rho0) within /fluid/max_divergence_error);
 /// 2. constant density: v* = v + dt (a_div + a_other + a^p(p)), until rho*_i <= rho0 (1 + eta).
+/// A step shorter than dx / c_s reads both bands as rates (sph/integrate.hpp, solve_rate_fraction).
 /// The stopping test reads the complementarity residual (compression, or over-pressure that
 /// p_i could give back). The divergence solve starts from zero, the density solve from half the
 /// last step's pressure where the fluid would compress (dfsph.cpp says why). Writes state.fluid.p

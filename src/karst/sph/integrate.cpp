@@ -54,6 +54,10 @@ Real viscous_step_limit(const FluidSettings& fluid, Real dx) {
     return nu > 0 ? k_viscous_step * dx * dx / nu : std::numeric_limits<Real>::infinity();
 }
 
+Real solve_rate_fraction(const FluidSettings& fluid, Real dx, Real dt) {
+    return std::min(Real(1), dt * fluid.sound_speed / dx);
+}
+
 Real cfl_time_step(const Model& model, const State& state) {
     const TimeSettings& t = model.scene.time;
     if (t.fixed_dt) return *t.fixed_dt;

@@ -47,6 +47,16 @@ Real viscous_step_limit(const FluidSettings& fluid, Real dx);
 /// 32 m/s diverged).
 Real artificial_kinematic_viscosity(const FluidSettings& fluid, Real dx);
 
+/// s = min(1, dt c_s / dx): the share of the sound's crossing time of a spacing that a step of dt
+/// is (c_s = /fluid/sound_speed). The pressure solves read their bands as rates through it
+/// (docs/method.md §4.3): a step at s < 1 is held to s times each band, and its density solve
+/// removes the share s of a compression. At dt >= dx / c_s nothing changes.
+/// [D] Read per step, the bands let a short step compress and release more per second than a
+/// long one: the density solve removed a whole compression e in one step, at about e dx / dt, and
+/// water stepped far below dx / c_s (viscous fluids, fixed short steps) gained energy
+/// (bench/results/notes.md). A weakly compressible fluid releases a compression at e c_s.
+Real solve_rate_fraction(const FluidSettings& fluid, Real dx, Real dt);
+
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max), dt_max), or the scene's fixed step
 /// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now;
 /// a_max that of the last step; also at most the pressure solve's bound

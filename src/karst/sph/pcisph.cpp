@@ -3,6 +3,7 @@
 #include "karst/core/parallel.hpp"
 #include "karst/coupling/boundary_pair.hpp"
 #include "karst/sph/density.hpp"
+#include "karst/sph/integrate.hpp"
 #include "karst/sph/pressure_acceleration.hpp"
 
 namespace karst {
@@ -81,6 +82,13 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     s.a_pressure.assign(n, Vec3::Zero());
     parallel_for(n, [&](Index i) { s.x_pred[i] = f.x[i] + dt * (f.v[i] + dt * s.a_other[i]); });
 
+    // The tolerance and the density target as rates: a step of the share `rate` of the sound's
+    // crossing time removes that share of a compression, within that share of the band
+    // (sph/integrate.hpp).
+    const Real rate = solve_rate_fraction(fs, model.dx, dt);
+    const auto target = [&](Index i) {
+        return std::max(rho0, f.rho[i] - rate * (f.rho[i] - rho0));
+    };
     PressureSolveReport report;
     while (report.iterations < fs.max_iterations) {
         // Predicted density at x* (walls stay put), clamped error, pressure update.
@@ -94,14 +102,15 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
             });
             s.fluid_porous.for_each(
                 i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
-            // Signed error, p clamped at 0 (docs/method.md §4.3); the stopping test reads the
-            // compression, or the over-pressure p_i could give back where the fluid expands.
-            const Real e = rho - rho0;
+            // Signed error from the target, p clamped at 0 (docs/method.md §4.3); the stopping
+            // test reads the compression, or the over-pressure p_i could give back where the
+            // fluid expands.
+            const Real e = rho - target(i);
             s.rho_err[i] = e > 0 ? e : std::min(-e, f.p[i] / s.delta[i]);
             f.p[i] = std::max(f.p[i] + s.delta[i] * e, Real(0));
         });
         report.max_density_error =
-            parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / rho0;
+            parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / (rate * rho0);
         pressure_acceleration_and_prediction(model, state, dt);
         ++report.iterations;
         // Stopping rule (docs/method.md §4.3; the paper's l.13 never ends).
