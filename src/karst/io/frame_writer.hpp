@@ -35,7 +35,7 @@ struct FrameLog {
     Real dt = 0;                ///< last step, s
     Index steps = 0;            ///< steps so far
     Index particles = 0;        ///< fluid particles now
-    Real density_error = 0;     ///< largest PCISPH density error since the last frame (fraction)
+    Real density_error = 0;     ///< largest pressure-solve residual since the last frame (fraction)
     Real mipps = 0;             ///< million particle-steps per second since the last frame
     Real kinetic_energy = 0;    ///< fluid + porous particles, J (sim/energy.hpp)
     Real potential_energy = 0;  ///< -sum m g.x, J

@@ -427,7 +427,8 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         progress.warn(fmt::format(
             "the density error exceeded /fluid/max_density_error = {:g} in {} of {} frames "
             "(largest {:.3g}): the pressure solve stopped at max_iterations or the step was "
-            "too long; raise /fluid/max_iterations or lower /time/cfl",
+            "too long; raise /fluid/max_iterations, or lower /time/cfl where the step is "
+            "longer than dx / c_s",
             density_tolerance, record.frames_over_tolerance, out->frames() - 1,
             record.max_density_error));
     progress.finish();

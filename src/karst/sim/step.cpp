@@ -166,8 +166,9 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
 
     // 4. Pressure solve with walls and porous particles as boundary: DFSPH (divergence, then
     //    constant density; sph/dfsph.hpp) or the paper's PCISPH loop (§4.3, M8). A solve that
-    //    leaves over 1 % compression is repeated with half the step (sph/integrate.hpp says why),
-    //    unless the step is fixed; nothing has moved yet, so only the step length changes.
+    //    leaves over 1 % compression (its residual, read as a rate) is repeated with half the step
+    //    (sph/integrate.hpp says why), unless the step is fixed; nothing has moved yet, so only the
+    //    step length changes.
     const FluidSettings& fs = model.scene.fluid;
     PressureSolveReport pressure;
     bool converged = false;
@@ -178,14 +179,17 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
                            : solve_pressure_pcisph(model, state, dt);
             converged =
                 pressure.max_density_error <= std::max(fs.max_density_error, k_step_density_error);
+            // Below dx / c_s the bands shrink with the step (sph/integrate.hpp), so a shorter
+            // step no longer makes the solve easier.
             if (converged || model.scene.time.fixed_dt || halvings == k_max_step_halvings ||
-                dt / 2 < model.scene.time.dt_min)
+                dt / 2 < model.scene.time.dt_min || solve_rate_fraction(fs, model.dx, dt / 2) < 1)
                 break;
             dt /= 2;
         }
     });
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
-    update_solver_time_step_limit(state, dt, dt < dt_wanted, converged, model.scene.time.dt_max);
+    update_solver_time_step_limit(state, dt, dt < dt_wanted, converged, model.scene.time.dt_max,
+                                  model.dx / fs.sound_speed);
 
     // 10. Solute diffusion among fluid particles (M18), on this step's densities and lists.
     timed(profile, Stage::SoluteDiffusion, [&] {

@@ -35,9 +35,9 @@ Real integrate_fluid(const Model& model, State& state, Real dt) {
 }
 
 void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged,
-                                   Real dt_max) {
+                                   Real dt_max, Real dt_rate) {
     if (!converged)
-        state.dt_solver_limit = 0.5 * dt;
+        state.dt_solver_limit = std::max(0.5 * dt, std::min(dt, dt_rate));
     else if (shortened)
         state.dt_solver_limit = dt;
     else if (state.dt_solver_limit < dt_max)
@@ -55,7 +55,7 @@ Real viscous_step_limit(const FluidSettings& fluid, Real dx) {
 }
 
 Real solve_rate_fraction(const FluidSettings& fluid, Real dx, Real dt) {
-    return std::min(Real(1), dt * fluid.sound_speed / dx);
+    return dt > 0 ? std::min(Real(1), dt * fluid.sound_speed / dx) : Real(1);
 }
 
 Real cfl_time_step(const Model& model, const State& state) {

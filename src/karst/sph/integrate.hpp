@@ -27,8 +27,10 @@ Real integrate_fluid(const Model& model, State& state, Real dt);
 /// motion compresses (about g dt^2 per layer, summed down a column) is what they must undo in
 /// their iterations; an unconverged solve leaves that compression, and the next impact throws it
 /// back out.
+/// `dt_rate` = dx / c_s: an unconverged solve does not bound the step below it, where the bands
+/// shrink with the step (solve_rate_fraction) and a shorter step no longer helps the solve.
 void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged,
-                                   Real dt_max);
+                                   Real dt_max, Real dt_rate);
 
 /// [D] The viscous terms are explicit, so a step is stable only below k_viscous_step dx^2 /
 /// nu_eff, nu_eff = nu + artificial_kinematic_viscosity. Measured at a fixed 1 ms step (dx 0.01
@@ -50,7 +52,7 @@ Real artificial_kinematic_viscosity(const FluidSettings& fluid, Real dx);
 /// s = min(1, dt c_s / dx): the share of the sound's crossing time of a spacing that a step of dt
 /// is (c_s = /fluid/sound_speed). The pressure solves read their bands as rates through it
 /// (docs/method.md §4.3): a step at s < 1 is held to s times each band, and its density solve
-/// removes the share s of a compression. At dt >= dx / c_s nothing changes.
+/// removes the share s of a compression. At dt >= dx / c_s nothing changes; 1 for dt <= 0.
 /// [D] Read per step, the bands let a short step compress and release more per second than a
 /// long one: the density solve removed a whole compression e in one step, at about e dx / dt, and
 /// water stepped far below dx / c_s (viscous fluids, fixed short steps) gained energy
