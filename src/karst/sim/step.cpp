@@ -170,6 +170,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     //    (sph/integrate.hpp says why), unless the step is fixed; nothing has moved yet, so only the
     //    step length changes.
     const FluidSettings& fs = model.scene.fluid;
+    const Real dt_sound = sound_crossing_time(fs, model.dx);
     PressureSolveReport pressure;
     bool converged = false;
     timed(profile, Stage::PressureSolve, [&] {
@@ -182,14 +183,14 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             // Below dx / c_s the bands shrink with the step (sph/integrate.hpp), so a shorter
             // step no longer makes the solve easier.
             if (converged || model.scene.time.fixed_dt || halvings == k_max_step_halvings ||
-                dt / 2 < model.scene.time.dt_min || solve_rate_fraction(fs, model.dx, dt / 2) < 1)
+                dt / 2 < model.scene.time.dt_min || dt / 2 < dt_sound)
                 break;
             dt /= 2;
         }
     });
     check_vectors(state.scratch.a_pressure, id, Stage::PressureSolve, t, "pressure acceleration");
     update_solver_time_step_limit(state, dt, dt < dt_wanted, converged, model.scene.time.dt_max,
-                                  model.dx / fs.sound_speed);
+                                  dt_sound);
 
     // 10. Solute diffusion among fluid particles (M18), on this step's densities and lists.
     timed(profile, Stage::SoluteDiffusion, [&] {

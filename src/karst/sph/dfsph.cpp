@@ -184,10 +184,7 @@ PressureSolveReport solve_pressure_dfsph(const Model& model, State& state, Real 
                                   BoundaryPressure::Hydrostatic, s.porous_v_pred);
     else
         s.porous_v_pred = state.porous.particles.v;
-    // The target: rho0, or the share `rate` of the way there from a compressed density.
-    const auto target = [&](Index i) {
-        return std::max(rho0, f.rho[i] - rate * (f.rho[i] - rho0));
-    };
+    const auto target = [&](Index i) { return rate_density_target(f.rho[i], rho0, rate); };
     parallel_for(n, [&](Index i) {
         const bool compressed =
             f.rho[i] + density_change(model, state, base, s.porous_v_pred, i, dt) > target(i);

@@ -54,8 +54,12 @@ Real viscous_step_limit(const FluidSettings& fluid, Real dx) {
     return nu > 0 ? k_viscous_step * dx * dx / nu : std::numeric_limits<Real>::infinity();
 }
 
+Real sound_crossing_time(const FluidSettings& fluid, Real dx) {
+    return dx / fluid.sound_speed;
+}
+
 Real solve_rate_fraction(const FluidSettings& fluid, Real dx, Real dt) {
-    return dt > 0 ? std::min(Real(1), dt * fluid.sound_speed / dx) : Real(1);
+    return dt > 0 ? std::min(Real(1), dt / sound_crossing_time(fluid, dx)) : Real(1);
 }
 
 Real cfl_time_step(const Model& model, const State& state) {

@@ -2,6 +2,8 @@
 #include "karst/sim/model.hpp"
 #include "karst/sim/state.hpp"
 
+#include <algorithm>
+
 namespace karst {
 
 /// Stage (docs/method.md §4.4): symplectic Euler v += dt (a_other + a_p), x += dt v; a particle
@@ -27,8 +29,9 @@ Real integrate_fluid(const Model& model, State& state, Real dt);
 /// motion compresses (about g dt^2 per layer, summed down a column) is what they must undo in
 /// their iterations; an unconverged solve leaves that compression, and the next impact throws it
 /// back out.
-/// `dt_rate` = dx / c_s: an unconverged solve does not bound the step below it, where the bands
-/// shrink with the step (solve_rate_fraction) and a shorter step no longer helps the solve.
+/// `dt_rate` = sound_crossing_time: an unconverged solve does not bound the step below it, where
+/// the bands shrink with the step (solve_rate_fraction) and a shorter step no longer helps the
+/// solve.
 void update_solver_time_step_limit(State& state, Real dt, bool shortened, bool converged,
                                    Real dt_max, Real dt_rate);
 
@@ -58,6 +61,15 @@ Real artificial_kinematic_viscosity(const FluidSettings& fluid, Real dx);
 /// water stepped far below dx / c_s (viscous fluids, fixed short steps) gained energy
 /// (bench/results/notes.md). A weakly compressible fluid releases a compression at e c_s.
 Real solve_rate_fraction(const FluidSettings& fluid, Real dx, Real dt);
+
+/// dx / c_s, s: below it the pressure solves' bands shrink with the step.
+Real sound_crossing_time(const FluidSettings& fluid, Real dx);
+
+/// The density solve's target at the share s of solve_rate_fraction: rho0, or the share s of the
+/// way there from a compressed rho_i.
+inline Real rate_density_target(Real rho_i, Real rho0, Real s) {
+    return std::max(rho0, rho_i - s * (rho_i - rho0));
+}
 
 /// M11: dt = min(lambda_v dx / v_max, 0.25 sqrt(dx / a_max), dt_max), or the scene's fixed step
 /// (the run stops when it falls below dt_min). v_max is the largest fluid or porous speed now;

@@ -86,9 +86,7 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     // crossing time removes that share of a compression, within that share of the band
     // (sph/integrate.hpp).
     const Real rate = solve_rate_fraction(fs, model.dx, dt);
-    const auto target = [&](Index i) {
-        return std::max(rho0, f.rho[i] - rate * (f.rho[i] - rho0));
-    };
+    const auto target = [&](Index i) { return rate_density_target(f.rho[i], rho0, rate); };
     PressureSolveReport report;
     while (report.iterations < fs.max_iterations) {
         // Predicted density at x* (walls stay put), clamped error, pressure update.
