@@ -33,8 +33,9 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 }
 
 /// Per-particle scaling factor delta_i (Pa per kg/m^3), M8 evaluated on the particle's own
-/// neighbourhood and capped at the prototype value:
-///   delta_i = rho0^2 / (2 dt^2 (|sum_j m_j grad W_ij + sum_k Psi_k grad W_ik|^2 + sum_j m_j^2
+/// neighbourhood, with the boundary twice as in the predicted density (boundary_density), and
+/// capped at the prototype value:
+///   delta_i = rho0^2 / (2 dt^2 (|sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik|^2 + sum_j m_j^2
 ///   |grad W_ij|^2)).
 /// Why [D]: M8's prototype (full fluid neighbourhood) omits the stiffness that Akinci wall
 /// neighbours add; at wall corners |sum_k Psi_k grad W_ik|^2 is several times the prototype's
@@ -53,10 +54,25 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
         // The boundary's sum_k Psi_k grad W_ik = rho0^2 sum_k c_ik x_ik is summed once a step.
         const FluidGradientSums fluid = fluid_gradient_sums(model, state, i);
         const Real denominator =
-            (fluid.sum + rho0_2 * s.boundary_sums.gradient[i]).squaredNorm() + fluid.squares;
+            (fluid.sum + 2 * rho0_2 * s.boundary_sums.gradient[i]).squaredNorm() + fluid.squares;
         delta[i] = k_pressure_relaxation *
                    (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
     });
+}
+
+/// sum_k Psi_k W(|x - x_k|) over fluid particle i's wall and porous neighbours (the step's
+/// lists): the boundary's part of M7's density at x, kg/m^3. Walls and porous particles stay put
+/// during the solve.
+Real boundary_density(const Model& model, const State& state, Index i, const Vec3& x) {
+    const FluidScratch& s = state.scratch;
+    const CubicKernel& W = model.kernel;
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Real>& psi = state.porous_scratch.psi;
+    Real rho = 0;
+    s.fluid_wall.for_each(
+        i, [&](Index k) { rho += model.walls.psi[k] * W.w((x - model.walls.x[k]).norm()); });
+    s.fluid_porous.for_each(i, [&](Index k) { rho += psi[k] * W.w((x - porous.x[k]).norm()); });
+    return rho;
 }
 
 }  // namespace
@@ -68,8 +84,6 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     const FluidSettings& fs = model.scene.fluid;
     const Real rho0 = model.rho0;
     const CubicKernel& W = model.kernel;
-    const PorousParticles& porous = state.porous.particles;
-    const std::vector<Real>& psi = state.porous_scratch.psi;
 
     // p starts at 0 every step (docs/method.md §4.3). A warm start from the last step's pressure
     // (signed update, p >= 0) was tried: it smooths the pressure but left a resting column
@@ -80,6 +94,9 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     s.rho_err.resize(n);
     compute_delta(model, state, dt, s.delta);
     s.a_pressure.assign(n, Vec3::Zero());
+    s.rho_boundary.resize(n);
+    parallel_for(n,
+                 [&](Index i) { s.rho_boundary[i] = boundary_density(model, state, i, f.x[i]); });
     parallel_for(n, [&](Index i) { s.x_pred[i] = f.x[i] + dt * (f.v[i] + dt * s.a_other[i]); });
 
     // The tolerance and the density target as rates: a step of the share `rate` of the sound's
@@ -89,17 +106,17 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     const auto target = [&](Index i) { return rate_density_target(f.rho[i], rho0, rate); };
     PressureSolveReport report;
     while (report.iterations < fs.max_iterations) {
-        // Predicted density at x* (walls stay put), clamped error, pressure update.
+        // Predicted density at x*, the boundary's change counted twice (docs/method.md §4.3):
+        // a boundary neighbour pushes with p_i + p_ik, which rises with p_i, so the pressure
+        // force's part linear in p is minus the transpose of this prediction's, and the solve
+        // projects orthogonally. With the boundary once, narrow and deep columns at rest were
+        // launched by a pressure that grew every iteration (bench/results/notes.md).
         parallel_for(n, [&](Index i) {
             const Vec3 xi = s.x_pred[i];
             Real rho = f.sph_mass[i] * W.w0();
             s.fluid_fluid.for_each(
                 i, [&](Index j) { rho += f.sph_mass[j] * W.w((xi - s.x_pred[j]).norm()); });
-            s.fluid_wall.for_each(i, [&](Index k) {
-                rho += model.walls.psi[k] * W.w((xi - model.walls.x[k]).norm());
-            });
-            s.fluid_porous.for_each(
-                i, [&](Index k) { rho += psi[k] * W.w((xi - porous.x[k]).norm()); });
+            rho += 2 * boundary_density(model, state, i, xi) - s.rho_boundary[i];
             // Signed error from the target, p clamped at 0 (docs/method.md §4.3); the stopping
             // test reads the compression, or the over-pressure p_i could give back where the
             // fluid expands.
