@@ -102,9 +102,8 @@ std::vector<KeySpec> make_schema() {
             "that keeps dense fluid from compressing further, then the constant-density solve, "
             "both "
             "with the Akinci boundary of walls and porous particles; pcisph: the paper's "
-            "predictive-corrective solver (docs/method.md §4.3), kept for comparison: it can gain "
-            "energy in "
-            "impacts.",
+            "predictive-corrective solver (docs/method.md §4.3), slower, and it settles shallow "
+            "water at rest less well.",
             {"dfsph", "pcisph"}),
         key("/fluid/max_density_error", T::Number, "", closed(1e-5, 0.1), 0.01,
             "The pressure solve stops when the largest predicted compression is below this "

@@ -38,7 +38,7 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 ///   delta_i = rho0^2 / (2 dt^2 (|sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik|^2 + sum_j m_j^2
 ///   |grad W_ij|^2)).
 /// Why [D]: M8's prototype (full fluid neighbourhood) omits the stiffness that Akinci wall
-/// neighbours add; at wall corners |sum_k Psi_k grad W_ik|^2 is several times the prototype's
+/// neighbours add; at wall corners |2 sum_k Psi_k grad W_ik|^2 is several times the prototype's
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
 /// diverges. Capping keeps the prototype everywhere it is stable (the interior, free surface).
 /// Then under-relaxed by k_pressure_relaxation [D] (sph/pressure_acceleration.hpp says why).
