@@ -30,23 +30,23 @@ struct BoundarySums {
 
 /// Data rebuilt every step from the physical state.
 struct FluidScratch {
-    CellRanges cells;                    ///< fluid particles sorted by cell
-    NeighbourLists fluid_fluid;          ///< fluid neighbours (self excluded)
-    NeighbourLists fluid_wall;           ///< wall neighbours
-    std::vector<Vec3> a_other;           ///< (n) non-pressure acceleration incl. gravity, m/s^2
-    std::vector<Vec3> a_pressure;        ///< (n) pressure acceleration, m/s^2
-    std::vector<Vec3> normal;            ///< (n) Akinci 2013 surface normal, dimensionless
-    std::vector<Vec3> x_pred;            ///< (n) PCISPH predicted position, m
-    std::vector<Real> rho_err;           ///< (n) predicted density error, kg/m^3
-    std::vector<Real> rho_boundary;      ///< (n) PCISPH: the boundary's part of rho_i at x, kg/m^3
-    std::vector<Vec3> v_pred;            ///< (n) DFSPH predicted velocity, m/s
-    std::vector<Vec3> a_divergence;      ///< (n) DFSPH divergence-solve acceleration, m/s^2
-    std::vector<Real> diagonal;          ///< (n) DFSPH -d rho*_i / d p_i, kg/m^3 per Pa
-    std::vector<Real> delta;             ///< (n) PCISPH scaling factor delta_i, Pa m^3/kg
-    std::vector<Real> pair_coefficient;  ///< per fluid pair (list layout): m_j / rho0^2 dW/dr / r
-    std::vector<Real> wall_coefficient;  ///< per wall pair: Psi_k / rho0^2 dW/dr / r
-    std::vector<Real> wall_hydrostatic;  ///< per wall pair: -rho0 g.x_ik, Pa
-    NeighbourLists fluid_porous;         ///< porous neighbours within h (Akinci boundary, §4.1)
+    CellRanges cells;                      ///< fluid particles sorted by cell
+    NeighbourLists fluid_fluid;            ///< fluid neighbours (self excluded)
+    NeighbourLists fluid_wall;             ///< wall neighbours
+    std::vector<Vec3> a_other;             ///< (n) non-pressure acceleration incl. gravity, m/s^2
+    std::vector<Vec3> a_pressure;          ///< (n) pressure acceleration, m/s^2
+    std::vector<Vec3> normal;              ///< (n) Akinci 2013 surface normal, dimensionless
+    std::vector<Vec3> x_pred;              ///< (n) PCISPH predicted position, m
+    std::vector<Real> rho_err;             ///< (n) predicted density error, kg/m^3
+    std::vector<Real> rho_boundary;        ///< (n) PCISPH: boundary density at x, kg/m^3
+    std::vector<Vec3> v_pred;              ///< (n) DFSPH predicted velocity, m/s
+    std::vector<Vec3> a_divergence;        ///< (n) DFSPH divergence-solve acceleration, m/s^2
+    std::vector<Real> diagonal;            ///< (n) DFSPH -d rho*_i / d p_i, kg/m^3 per Pa
+    std::vector<Real> delta;               ///< (n) PCISPH scaling factor delta_i, Pa m^3/kg
+    std::vector<Real> pair_coefficient;    ///< per fluid pair (list layout): m_j / rho0^2 dW/dr / r
+    std::vector<Real> wall_coefficient;    ///< per wall pair: Psi_k / rho0^2 dW/dr / r
+    std::vector<Real> wall_hydrostatic;    ///< per wall pair: -rho0 g.x_ik, Pa
+    NeighbourLists fluid_porous;           ///< porous neighbours within h (Akinci boundary, §4.1)
     std::vector<Real> porous_coefficient;  ///< per porous pair: Psi_k / rho0^2 dW/dr / r
     std::vector<Real> porous_hydrostatic;  ///< per porous pair: -rho0 g.x_ik, Pa
     BoundarySums boundary_sums;            ///< (n) the boundary pairs summed (walls and porous)
