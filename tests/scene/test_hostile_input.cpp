@@ -2,13 +2,16 @@
 // path (exit 2), or runs and stops loudly (exit 1). The scenes of tests/data/bad_scenes are the
 // regression cases found by mutating the shipped scenes; the deep and huge ones are built here.
 #include "karst/scene/read_json.hpp"
+#include "karst/sim/model.hpp"
 #include "karst/sim/run.hpp"
 
 #include "support/files.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -65,6 +68,91 @@ TEST(HostileInput, ANumberADoubleCannotHoldIsNamedByItsPath) {
     EXPECT_EQ(b.path, "/gravity/2");
     const SceneError c = test::refuse_scene(R"({"name":"t","particle_spacing":-2e308})");
     EXPECT_EQ(c.path, "/particle_spacing");
+}
+
+TEST(HostileInput, WhatWouldSilentlyChangeTheSceneIsRefused) {
+    // A key given twice: the parser would keep the last.
+    const SceneError a = test::refuse_scene(fluid_scene(k_box, R"(,"particle_spacing":0.02)"));
+    EXPECT_EQ(a.path, "/particle_spacing");
+    EXPECT_NE(a.expected.find("each key once"), std::string::npos);
+    const SceneError b = test::refuse_scene(
+        fluid_scene(R"({"type":"box","min":[0,0,0],"max":[1,1,1],"max":[0.2,0.2,0.2]})"));
+    EXPECT_EQ(b.path, "/fluid_blocks/0/shape/max");
+    // A number that underflows to 0; a subnormal one is held, and zeros are zeros.
+    const SceneError c = test::refuse_scene(fluid_scene(k_box, R"(,"time":{"end":1e-400})"));
+    EXPECT_EQ(c.path, "/time/end");
+    EXPECT_EQ(c.found, "1e-400");
+    EXPECT_EQ(test::refuse_scene(fluid_scene(k_box, R"(,"gravity":[0,-2.5e-999,-9.81])")).path,
+              "/gravity/1");
+    EXPECT_NO_THROW(read_scene_json(R"([1e-320, 0e-400, 0.000e-999, -0.0])"));
+    // A NUL byte: the parser would stop there and ignore the rest.
+    const std::string nul = fluid_scene(k_box) + std::string(1, '\0') + "{{{ not json";
+    const SceneError d = test::refuse_scene(nul);
+    EXPECT_NE(d.found.find("NUL byte"), std::string::npos);
+}
+
+TEST(HostileInput, MessagesNameKeysWithoutEchoingThemRaw) {
+    // A key holding '/' is a pointer token (~1); control characters are escaped, long keys cut.
+    const SceneError a = test::refuse_scene(fluid_scene(k_box, R"(,"fluid/viscosity":1)"));
+    EXPECT_EQ(a.path, "/fluid~1viscosity");
+    EXPECT_NE(a.found.find("\"fluid/viscosity\""), std::string::npos);
+    const SceneError b = test::refuse_scene(fluid_scene(k_box, R"(,"a\u001b[2Jb":1)"));
+    EXPECT_EQ(b.path, "/a\\u001b[2Jb");
+    EXPECT_EQ(std::string(b.what()).find('\x1b'), std::string::npos);
+    const SceneError c =
+        test::refuse_scene(fluid_scene(k_box, ",\"" + std::string(1 << 20, 'k') + "\":1"));
+    EXPECT_LT(std::string(c.what()).size(), 2000u);
+    // A misspelt shape type is named as the unknown key it is.
+    const SceneError d =
+        test::refuse_scene(fluid_scene(R"({"typ":"box","min":[0,0,0],"max":[0.2,0.2,0.2]})"));
+    EXPECT_EQ(d.path, "/fluid_blocks/0/shape/typ");
+    EXPECT_NE(d.expected.find("\"type\""), std::string::npos);
+    // A syntax error says where, in words, without the parser's internal tag.
+    const SceneError e = test::refuse_scene(fluid_scene(k_box) + " x");
+    EXPECT_NE(e.found.find("line 1"), std::string::npos) << e.found;
+    EXPECT_EQ(e.found.find("json.exception"), std::string::npos) << e.found;
+}
+
+TEST(HostileInput, ShapesFarApartAreRefusedOrSampledPartByPart) {
+    const auto spheres = [](double apart) {
+        return fmt::format(
+            R"({{"type":"union","shapes":[{{"type":"sphere","center":[0,0,0],"radius":0.1}},)"
+            R"({{"type":"sphere","center":[{0},{0},{0}],"radius":0.1}}]}})",
+            apart);
+    };
+    // 300 m apart at dx 0.05: a neighbour grid of 2.7e10 cells, refused before any sampling
+    // (which once visited all 2e11 lattice points of the box).
+    const SceneError e = test::refuse_scene(fluid_scene(spheres(300)));
+    EXPECT_EQ(e.path, "/particle_spacing");
+    EXPECT_NE(e.expected.find("neighbour grid"), std::string::npos);
+    // 3 m apart: each sphere's box is visited, and the particles are those of two blocks.
+    const Model together = build_model(parse_scene(fluid_scene(spheres(3))));
+    const Model apart =
+        build_model(parse_scene(R"({"name":"t","particle_spacing":0.05,"fluid_blocks":[)"
+                                R"({"shape":{"type":"sphere","center":[0,0,0],"radius":0.1}},)"
+                                R"({"shape":{"type":"sphere","center":[3,3,3],"radius":0.1}}]})"));
+    ASSERT_EQ(together.initial_x.size(), 64u);
+    auto sorted = [](std::vector<Vec3> x) {
+        std::sort(x.begin(), x.end(), [](const Vec3& p, const Vec3& q) {
+            return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+        });
+        return x;
+    };
+    EXPECT_EQ(sorted(together.initial_x), sorted(apart.initial_x));
+}
+
+TEST(HostileInput, ASolidThatCannotMeshIsRefusedWhereItGetsABiotProblem) {
+    const auto solid = [](const std::string& max) {
+        return R"({"name":"t","particle_spacing":0.05,"porous_solids":[{"shape":{"type":"box",)"
+               R"("min":[0,0,0],"max":)" +
+               max + R"(}}],"poroelastic":{"time_step":0.05}})";
+    };
+    for (const char* max : {"[0.05,0.05,0.05]", "[0.5,0.5,0.05]"}) {
+        const SceneError e = test::refuse_scene(solid(max));
+        EXPECT_EQ(e.path, "/porous_solids/0/shape") << max;
+        EXPECT_NE(e.expected.find("two particles thick"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(build_model(parse_scene(solid("[0.1,0.1,0.1]"))));
 }
 
 TEST(HostileInput, GeometryBeyondTheLatticeIsRefusedBeforeCounting) {
@@ -153,6 +241,13 @@ TEST(HostileInput, TheSceneNameStaysInsideTheOutputFolder) {
         EXPECT_EQ(e.path, "/name") << name;
     }
     EXPECT_NO_THROW(build_model(parse_scene(fluid_scene(k_box))));
+    // A folder name longer than file systems allow would fail only when the run creates it.
+    const auto named = [](size_t bytes) {
+        return R"({"name":")" + std::string(bytes, 'n') +
+               R"(","particle_spacing":0.05,"fluid_blocks":[{"shape":)" + k_box + "}]}";
+    };
+    EXPECT_EQ(test::refuse_scene(named(129)).path, "/name");
+    EXPECT_NO_THROW(parse_scene(named(128)));
 }
 
 TEST(HostileInput, OnlyARegularFileIsReadAsAScene) {

@@ -85,13 +85,9 @@ void lattice_range(const Aabb& box, Real reach, Real dx, LatticeIndex& lo, Latti
     }
 }
 
-}  // namespace
-
-std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, Real hi) {
-    const Real reach = std::isfinite(hi) ? std::max(hi, Real(0)) : 0;
-    LatticeIndex a, b;
-    lattice_range(shape.bounds(), reach, dx, a, b);
-    std::vector<LatticeIndex> out;
+/// Lattice points of [a, b] in the band (lo, hi] of `shape`, appended in (k, j, i) order.
+void sample_range(const Shape& shape, Real dx, Real lo, Real hi, const LatticeIndex& a,
+                  const LatticeIndex& b, std::vector<LatticeIndex>& out) {
     for (std::int64_t k = a[2]; k <= b[2]; ++k)
         for (std::int64_t j = a[1]; j <= b[1]; ++j)
             for (std::int64_t i = a[0]; i <= b[0]; ++i) {
@@ -99,6 +95,46 @@ std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, R
                 const Real d = shape.signed_distance(lattice_point(idx, dx));
                 if (d > lo && d <= hi) out.push_back(idx);
             }
+}
+
+double range_points(const LatticeIndex& a, const LatticeIndex& b) {
+    double n = 1;
+    for (int d = 0; d < 3; ++d) n *= double(b[d] - a[d] + 1);
+    return n;
+}
+
+}  // namespace
+
+std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, Real hi) {
+    const Real reach = std::isfinite(hi) ? std::max(hi, Real(0)) : 0;
+    LatticeIndex a, b;
+    lattice_range(shape.bounds(), reach, dx, a, b);
+    std::vector<LatticeIndex> out;
+    // A union whose parts lie far apart: visit only each part's box (grown by the band's
+    // reach, which holds every point of the union's band near that part), then drop the points
+    // two boxes share. Sorted in (k, j, i) order, the result is that of the single box.
+    if (shape.kind == Shape::Kind::Union) {
+        std::vector<std::pair<LatticeIndex, LatticeIndex>> parts;
+        double part_points = 0;
+        for (const Shape& c : shape.children) {
+            LatticeIndex ca, cb;
+            lattice_range(c.bounds(), reach, dx, ca, cb);
+            parts.push_back({ca, cb});
+            part_points += range_points(ca, cb);
+        }
+        if (part_points < 0.5 * range_points(a, b)) {
+            for (const auto& [ca, cb] : parts) sample_range(shape, dx, lo, hi, ca, cb, out);
+            const auto zyx = [](const LatticeIndex& p) {
+                return std::array<std::int64_t, 3>{p[2], p[1], p[0]};
+            };
+            std::sort(out.begin(), out.end(), [&](const LatticeIndex& p, const LatticeIndex& q) {
+                return zyx(p) < zyx(q);
+            });
+            out.erase(std::unique(out.begin(), out.end()), out.end());
+            return out;
+        }
+    }
+    sample_range(shape, dx, lo, hi, a, b, out);
     return out;
 }
 

@@ -32,6 +32,9 @@ std::uint64_t scene_fingerprint(json doc) {
 /// Scenes are hand-written or generated descriptions, never data: 64 MB is far beyond any.
 constexpr std::uintmax_t k_max_scene_bytes = std::uintmax_t(64) << 20;
 
+/// The name is the output folder's: file systems allow 255 bytes, and 128 leaves room.
+constexpr size_t k_max_name_bytes = 128;
+
 Vec3 vec3(const json& v) {
     return {v[0].get<Real>(), v[1].get<Real>(), v[2].get<Real>()};
 }
@@ -83,9 +86,15 @@ Scene parse_scene(const std::string& text) {
     const bool control = std::any_of(s.name.begin(), s.name.end(),
                                      [](char c) { return static_cast<unsigned char>(c) < 0x20; });
     if (s.name.find_first_of("/\\") != std::string::npos ||
-        s.name.find("..") != std::string::npos || s.name == "." || control)
-        throw SceneError("/name", "a plain folder name (no '/', '\\', '..' or control characters)",
-                         doc["name"].dump());
+        s.name.find("..") != std::string::npos || s.name == "." || control ||
+        s.name.size() > k_max_name_bytes)
+        throw SceneError("/name",
+                         fmt::format("a plain folder name of at most {} bytes (no '/', '\\', "
+                                     "'..' or control characters)",
+                                     k_max_name_bytes),
+                         s.name.size() > k_max_name_bytes
+                             ? fmt::format("a name of {} bytes", s.name.size())
+                             : doc["name"].dump());
     s.particle_spacing = doc["particle_spacing"];
     s.gravity = vec3(doc["gravity"]);
     if (doc.contains("domain")) {
@@ -186,7 +195,8 @@ Scene parse_scene(const std::string& text) {
             mat.strength_across = j["layering"]["tensile_strength_across"].get<Real>();
         }
         if (mat.layering_normal.norm() < 1e-6)
-            throw SceneError(solid.path + "/layering/normal", "a non-zero direction", "[0, 0, 0]");
+            throw SceneError(solid.path + "/layering/normal", "a direction of length at least 1e-6",
+                             j["layering"]["normal"].dump());
         for (size_t w = 0; w < j["wet_regions"].size(); ++w)
             solid.wet_regions.push_back(
                 {read_shape(j["wet_regions"][w]["region"],

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <string_view>
 #include <vector>
 
 namespace karst {
@@ -23,13 +25,22 @@ public:
     bool number_integer(json::number_integer_t n) { return value(), dom_.number_integer(n); }
     bool number_unsigned(json::number_unsigned_t n) { return value(), dom_.number_unsigned(n); }
     bool number_float(json::number_float_t x, const json::string_t& s) {
+        // A literal with a non-zero digit before its exponent that reads as 0 underflowed.
+        const std::string_view mantissa = std::string_view(s).substr(0, s.find_first_of("eE"));
+        if (x == 0 && mantissa.find_first_of("123456789") != std::string_view::npos)
+            throw SceneError(pending_path(), "a number a double can hold (0 or |x| > 4.9e-324)", s);
         return value(), dom_.number_float(x, s);
     }
     bool string(json::string_t& s) { return value(), dom_.string(s); }
     bool binary(json::binary_t& b) { return value(), dom_.binary(b); }
     bool start_object(std::size_t n) { return open(false), dom_.start_object(n); }
     bool key(json::string_t& k) {
-        levels_.back().key = k;
+        Level& l = levels_.back();
+        l.key = json_pointer_token(k);
+        if (std::find(l.keys.begin(), l.keys.end(), k) != l.keys.end())
+            throw SceneError(pending_path(), "each key once in an object",
+                             "it a second time (the first would be ignored)");
+        l.keys.push_back(k);
         return dom_.key(k);
     }
     bool end_object() { return levels_.pop_back(), dom_.end_object(); }
@@ -39,16 +50,21 @@ public:
     bool parse_error(std::size_t byte, const std::string& token, const json::exception& e) {
         if (e.id == 406)  // a number out of the range of a double
             throw SceneError(pending_path(), "a number a double can hold (|x| < 1.8e308)", token);
+        // nlohmann's text without its "[json.exception.parse_error.101] " tag.
+        std::string what = e.what();
+        if (what.size() > 0 && what[0] == '[') what.erase(0, what.find("] ") + 2);
         throw SceneError(pending_path(), "valid JSON",
-                         fmt::format("a syntax error at byte {}: {}", byte, e.what()));
+                         fmt::format("a syntax error (byte {}, near {}): {}", byte,
+                                     pending_path().empty() ? "/" : pending_path(), what));
     }
 
 private:
     struct Level {
         bool array = false;
         std::size_t next_index = 0;
-        std::string key;
-        std::string path;  ///< of this array or object
+        std::string key;                ///< the last key read, as a pointer token
+        std::vector<std::string> keys;  ///< every key read in this object
+        std::string path;               ///< of this array or object
     };
 
     /// The path the next value gets (its key or index in the innermost open value).
@@ -68,7 +84,7 @@ private:
             throw SceneError(path, fmt::format("values nested at most {} deep", k_max_json_depth),
                              "a deeper array or object");
         value();
-        levels_.push_back({array, 0, "", path});
+        levels_.push_back({array, 0, "", {}, path});
     }
 
     nlohmann::detail::json_sax_dom_parser<json> dom_;
@@ -77,7 +93,27 @@ private:
 
 }  // namespace
 
+std::string json_pointer_token(const std::string& key) {
+    constexpr size_t k_longest = 64;
+    std::string out;
+    for (size_t i = 0; i < key.size() && i < k_longest; ++i) {
+        const unsigned char c = static_cast<unsigned char>(key[i]);
+        if (c == '~')
+            out += "~0";
+        else if (c == '/')
+            out += "~1";
+        else if (c < 0x20 || c == 0x7f)
+            out += fmt::format("\\u{:04x}", c);
+        else
+            out += char(c);
+    }
+    if (key.size() > k_longest) out += fmt::format("... ({} bytes)", key.size());
+    return out;
+}
+
 json read_scene_json(const std::string& text) {
+    if (const size_t nul = text.find('\0'); nul != std::string::npos)
+        throw SceneError("", "JSON text", fmt::format("a NUL byte at byte {}", nul));
     json doc;
     PathTrackingBuilder builder(doc);
     json::sax_parse(text, &builder);

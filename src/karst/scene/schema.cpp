@@ -42,7 +42,8 @@ std::vector<KeySpec> make_schema() {
     const json zero3 = json::array({0.0, 0.0, 0.0});
     return {
         required("/name", T::String, "", any(),
-                 "Scene name; output goes to out/<name>/ by default."),
+                 "Scene name; output goes to out/<name>/ by default. A plain folder name of at "
+                 "most 128 bytes (no '/', '\\', '..' or control characters)."),
         required("/particle_spacing", T::Number, "m", positive(10.0),
                  "Particle spacing dx. The SPH support radius is h = 2 dx (docs/method.md §1)."),
         key("/gravity", T::Vec3, "m/s^2", closed(-1000, 1000), json::array({0.0, 0.0, -9.81}),
@@ -520,7 +521,8 @@ std::string scene_schema_markdown() {
         "A scene is one JSON object. Units are SI. Unknown keys, wrong types and out-of-range "
         "values\n"
         "are refused before simulating, with the JSON path, what was expected and what was found\n"
-        "(exit code 2). `[]` stands for any array index. Geometry objects (`shape`) are described "
+        "(exit code 2); so is a key given twice in one object and a number too small for a double\n"
+        "(1e-400). `[]` stands for any array index. Geometry objects (`shape`) are described "
         "by\n"
         "the `shape` rows: `shape/type` picks the kind and `shape:<type>/...` lists its keys;\n"
         "`union` and `difference` nest further shapes. All particles lie on one lattice\n"

@@ -1,5 +1,7 @@
 #include "karst/scene/validate.hpp"
 
+#include "karst/scene/read_json.hpp"
+
 #include "karst/scene/scene_error.hpp"
 #include "karst/scene/schema.hpp"
 
@@ -101,7 +103,9 @@ private:
         }
         std::string expected = best.empty() ? "one of the keys " + allowed
                                             : "a known key (did you mean \"" + best + "\"?)";
-        throw SceneError(path + "/" + name, expected, "unknown key \"" + name + "\"");
+        std::string shown = json(name).dump();  // quoted, control characters escaped
+        if (shown.size() > 70) shown = shown.substr(0, 67) + "...";
+        throw SceneError(path + "/" + json_pointer_token(name), expected, "unknown key " + shown);
     }
 
     void number(const json& v, const KeySpec& k, const std::string& path, bool integer) {
@@ -138,8 +142,12 @@ private:
         if (!v.is_object()) throw SceneError(path, "a shape object", describe_value(v));
         const auto& table = children_by_parent();
         const KeySpec* type_key = table.at("shape").front();
-        if (!v.contains("type"))
+        if (!v.contains("type")) {
+            // A misspelt "type" is named as the unknown key it is.
+            for (auto it = v.begin(); it != v.end(); ++it)
+                if (edit_distance(it.key(), "type") < 3) unknown_key(it.key(), {type_key}, path);
             throw SceneError(path + "/type", describe_type(*type_key) + " (required)", "nothing");
+        }
         value(v["type"], *type_key, path + "/type");
         std::vector<const KeySpec*> keys = table.at("shape");
         const auto& specific = table.at("shape:" + v["type"].get<std::string>());

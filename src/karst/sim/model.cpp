@@ -5,6 +5,7 @@
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/porous_materials.hpp"
 #include "karst/sph/integrate.hpp"
+#include "karst/sph/neighbour_grid.hpp"
 
 #include <fmt/format.h>
 
@@ -66,6 +67,34 @@ double available_memory_bytes() {
     return double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
 }
 
+/// The neighbour grid covers the domain: the scene's, or the box around every shape (walls with
+/// their layers) grown by 4 h as build_model makes it. Checked before any sampling, whose cost
+/// grows with a shape's box: a union of two spheres 300 m apart sampled for an hour. h = 2 dx as
+/// in build_model.
+void check_domain_grid(const Scene& s, Real h) {
+    if (s.domain) {
+        (void)UniformGrid(*s.domain, h);  // refuses at /domain
+        return;
+    }
+    Aabb box;
+    for (const FluidBlock& b : s.fluid_blocks) box.extend(b.shape.bounds());
+    for (const PorousSolid& p : s.porous_solids) box.extend(p.shape.bounds());
+    for (const Wall& w : s.walls)
+        box.extend(w.shape.bounds().padded(w.layers * s.particle_spacing));
+    box = box.padded(4 * h);
+    const double cells = grid_cell_count(box, h);
+    if (!(cells <= k_max_grid_cells)) {
+        const Vec3 size = box.max - box.min;
+        throw SceneError(
+            "/particle_spacing",
+            fmt::format("shapes within a box of at most {:g} cells of h = 2 x spacing (the "
+                        "neighbour grid; or set /domain)",
+                        k_max_grid_cells),
+            fmt::format("{} m, with shapes spanning {:.3g} x {:.3g} x {:.3g} m: {:.3g} cells",
+                        s.particle_spacing, size[0], size[1], size[2], cells));
+    }
+}
+
 /// Particles and the memory a run of them needs, estimated before anything is allocated, so a
 /// scene too large for the machine is refused instead of dying of bad_alloc mid-run.
 void check_particle_budget(const Scene& s) {
@@ -76,6 +105,7 @@ void check_particle_budget(const Scene& s) {
         check_lattice_extent(p.shape, dx, 0, p.path + "/shape");
     for (const Wall& w : s.walls)
         check_lattice_extent(w.shape, dx, w.layers * dx, w.path + "/shape");
+    check_domain_grid(s, 2 * dx);
     double fluid = 0, porous = 0, walls = 0;
     // Each loop stops once the cap is passed: a scene of thousands of blocks is refused at once.
     for (const FluidBlock& b : s.fluid_blocks) {
@@ -361,8 +391,30 @@ void set_up_porous_materials(Model& m) {
 /// The Biot problems a scene can pose (docs/method.md §5): a poroelastic-only solid needs pores,
 /// and in a coupled scene only anchored fragments of permeable solids get one, so constraints on
 /// any other solid would be silently ignored.
+/// A solid that gets a Biot problem must mesh into tetrahedra: particles on at least two lattice
+/// planes along every axis (one particle, or a one-layer sheet, gives no element).
+void check_meshable(const Model& m, const PorousBody& body) {
+    Aabb box;
+    for (const Vec3& x : body.rest_x) box.extend(x);
+    const PorousSolid& s = m.scene.porous_solids[body.solid];
+    if (box.empty() || ((box.max - box.min).array() < 0.5 * m.dx).any())
+        throw SceneError(
+            s.path + "/shape",
+            "a solid at least two particles thick along every axis (its Biot "
+            "problem needs tetrahedra)",
+            fmt::format("{} particles spanning {:.3g} x {:.3g} x {:.3g} m", body.rest_x.size(),
+                        (box.max - box.min)[0], (box.max - box.min)[1], (box.max - box.min)[2]));
+}
+
 void check_biot_setup(const Model& m) {
     const Scene& scene = m.scene;
+    for (const PorousBody& body : m.porous) {
+        const PorousSolid& s = scene.porous_solids[body.solid];
+        const bool biot = m.poroelastic_only() ||
+                          (scene.poroelastic.coupled_fragments && s.anchored &&
+                           !s.constraints.empty() && s.material.porosity >= k_min_porosity);
+        if (biot) check_meshable(m, body);
+    }
     for (const PorousSolid& s : scene.porous_solids) {
         if (m.poroelastic_only()) {
             if (s.material.porosity < k_min_porosity)

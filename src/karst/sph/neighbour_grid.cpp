@@ -13,23 +13,14 @@
 
 namespace karst {
 
-namespace {
-/// A grid this large (4 bytes per cell) would cost gigabytes: the domain is too big for dx.
-constexpr double k_max_cells = 4e8;
-}  // namespace
-
 UniformGrid::UniformGrid(const Aabb& box, Real cell_size) : origin(box.min), cell(cell_size) {
-    double cells = 1;
-    for (int d = 0; d < 3; ++d) {
-        const double n = std::max(1.0, std::ceil((box.max[d] - box.min[d]) / cell_size));
-        cells *= n;
-        if (cells > k_max_cells)
-            throw SceneError("/domain",
-                             fmt::format("a domain of at most {:g} cells of size h = {:g} m",
-                                         k_max_cells, cell_size),
-                             "a larger domain (shrink it or raise particle_spacing)");
-        dims[d] = int(n);
-    }
+    if (!(grid_cell_count(box, cell_size) <= k_max_grid_cells))
+        throw SceneError("/domain",
+                         fmt::format("a domain of at most {:g} cells of size h = {:g} m",
+                                     k_max_grid_cells, cell_size),
+                         "a larger domain (shrink it or raise particle_spacing)");
+    for (int d = 0; d < 3; ++d)
+        dims[d] = int(std::max(1.0, std::ceil((box.max[d] - box.min[d]) / cell_size)));
 }
 
 std::array<int, 3> UniformGrid::coords(const Vec3& x) const {

@@ -13,13 +13,24 @@
 
 namespace karst {
 
+/// A grid this large (4 bytes per cell) would cost gigabytes: the domain is too big for h.
+inline constexpr double k_max_grid_cells = 4e8;
+
+/// Cells of edge `cell_size` covering `box`, at least one per axis.
+inline double grid_cell_count(const Aabb& box, Real cell_size) {
+    double cells = 1;
+    for (int d = 0; d < 3; ++d)
+        cells *= std::max(1.0, std::ceil((box.max[d] - box.min[d]) / cell_size));
+    return cells;
+}
+
 struct UniformGrid {
     Vec3 origin = Vec3::Zero();  ///< lower corner of cell (0, 0, 0), m
     Real cell = 1;               ///< cell edge = support radius h, m
     std::array<int, 3> dims{1, 1, 1};
 
     UniformGrid() = default;
-    /// Grid covering `box`; throws SceneError if it would need more than `max_cells` cells.
+    /// Grid covering `box`; throws SceneError if it would need more than k_max_grid_cells.
     UniformGrid(const Aabb& box, Real cell_size);
     Index cell_count() const { return Index(dims[0]) * dims[1] * dims[2]; }
     std::array<int, 3> coords(const Vec3& x) const;
