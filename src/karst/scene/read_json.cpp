@@ -4,8 +4,8 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 namespace karst {
@@ -37,10 +37,9 @@ public:
     bool key(json::string_t& k) {
         Level& l = levels_.back();
         l.key = json_pointer_token(k);
-        if (std::find(l.keys.begin(), l.keys.end(), k) != l.keys.end())
+        if (!l.keys.insert(k).second)
             throw SceneError(pending_path(), "each key once in an object",
                              "it a second time (the first would be ignored)");
-        l.keys.push_back(k);
         return dom_.key(k);
     }
     bool end_object() { return levels_.pop_back(), dom_.end_object(); }
@@ -62,9 +61,9 @@ private:
     struct Level {
         bool array = false;
         std::size_t next_index = 0;
-        std::string key;                ///< the last key read, as a pointer token
-        std::vector<std::string> keys;  ///< every key read in this object
-        std::string path;               ///< of this array or object
+        std::string key;                       ///< the last key read, as a pointer token
+        std::unordered_set<std::string> keys;  ///< every key read in this object
+        std::string path;                      ///< of this array or object
     };
 
     /// The path the next value gets (its key or index in the innermost open value).
