@@ -1,5 +1,6 @@
 // SpdSolve::compute_split: a matrix whose nodes were duplicated along a cut, solved through the
 // factor of the uncut matrix, gives the solution of its own factorisation.
+#include "karst/core/check.hpp"
 #include "karst/pfem/sparse_linear.hpp"
 
 #include <gtest/gtest.h>
@@ -158,6 +159,16 @@ TEST(SpdSplit, AMatrixThatIsNoSplitOrTooBigASplitIsRefused) {
     EXPECT_FALSE(split.compute_split(cut.matrix(), whole, rows_in(cut, grid), 1e-6));
     EXPECT_TRUE(split.compute_split(cut.matrix(), whole, rows_in(cut, grid), 100.0));
     EXPECT_LT(solve_difference(split, cut.matrix()), 1e-10);
+}
+
+TEST(SpdSolve, AMatrixThatIsNotPositiveDefiniteIsANumericalFailure) {
+    // A part of a solid without support, or an indefinite material, gives such a matrix: the
+    // step reports it as a watchdog stop, not as a bug.
+    std::vector<Eigen::Triplet<Real>> t{{0, 0, 1.0}, {0, 1, 2.0}, {1, 0, 2.0}, {1, 1, 1.0}};
+    SparseMatrix A(2, 2);
+    A.setFromTriplets(t.begin(), t.end());
+    SpdSolve solve;
+    EXPECT_THROW(solve.compute(A, false, {}), NumericalFailure);
 }
 
 }  // namespace

@@ -188,5 +188,15 @@ TEST(EnergyAccount, ReleasedIsStartingKineticPlusLargestPotentialDrop) {
     EXPECT_DOUBLE_EQ(a.largest_rise_over_start(), 0);
 }
 
+TEST(EnergyAccount, AGainWithNothingReleasedIsReported) {
+    EnergyAccount a({0, 80});
+    a.add({0, 80});
+    a.add({1e-7, 80});  // round-off of an 80 J account
+    EXPECT_FALSE(a.gained_more_than(0.05));
+    a.add({3.9, 80});  // a dissolving block that made 3.9 J while nothing fell
+    EXPECT_DOUBLE_EQ(a.released(), 0);
+    EXPECT_TRUE(a.gained_more_than(0.05));
+}
+
 }  // namespace
 }  // namespace karst

@@ -351,8 +351,10 @@ TEST(HostileInput, EveryKeptSceneEndsWithItsExitCode) {
         {"crash_run_cave_biot_nan_segv.json", 0, 1},
         {"hang_biot_time_step_1e-300.json", 2, 2},
         {"rc0_dt_min_not_enforced.json", 0, 1},
+        {"rc0_fast_fragment_escapes_container.json", 0, 1},
         {"rc0_fixed_dt_overshoots_end.json", 0, 0},
         {"rc0_nan_biot_fixed_strain.json", 0, 1},
+        {"rc0_poroelastic_spread_without_elements.json", 0, 1},
         {"rc1_biot_time_step_denormal.json", 2, 2},
         {"watchdog_ok_speed.json", 0, 0},
     };

@@ -1,5 +1,7 @@
 #include "karst/pfem/amg_solver.hpp"
 
+#include "karst/core/check.hpp"
+
 #include "karst/core/timer.hpp"
 
 #include <HYPRE.h>
@@ -48,7 +50,7 @@ private:
 void check(HYPRE_Int error, const char* what) {
     if (error) {
         HYPRE_ClearAllErrors();
-        throw std::runtime_error(std::string("hypre: ") + what + " failed");
+        throw NumericalFailure(std::string("hypre: ") + what + " failed");
     }
 }
 
@@ -156,9 +158,9 @@ struct AmgSolver::Impl {
         HYPRE_PCGGetFinalRelativeResidualNorm(pcg, &residual);
         HYPRE_ClearAllErrors();  // "not converged" is judged below, on the residual
         if (!(residual * std::sqrt(right_side) <= target * (1 + 1e-9)))
-            throw std::runtime_error("AMG-preconditioned CG did not converge: relative residual " +
-                                     std::to_string(residual) + " after " +
-                                     std::to_string(iterations) + " iterations");
+            throw NumericalFailure("AMG-preconditioned CG did not converge: relative residual " +
+                                   std::to_string(residual) + " after " +
+                                   std::to_string(iterations) + " iterations");
         HYPRE_IJVectorGetValues(ij_x, n, rows.data(), solution.data());
         return iterations;
     }

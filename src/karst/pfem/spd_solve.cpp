@@ -61,7 +61,10 @@ void SpdSolve::compute(const SparseMatrix& A, bool iterative, const AmgOptions& 
     if (!m_direct->analysed) m_direct->llt.analyzePattern(A), m_direct->analysed = true;
     m_direct->llt.factorize(A);
     m_direct->rows = Index(A.rows());
-    KARST_CHECK(m_direct->llt.info() == Eigen::Success);
+    if (m_direct->llt.info() != Eigen::Success)
+        throw NumericalFailure(
+            "the elasticity matrix is not positive definite (CHOLMOD's factorisation failed): a "
+            "part of the solid has no support, or its material is degenerate");
 }
 
 namespace {

@@ -1,11 +1,14 @@
 #include "karst/pfem/structure_stages.hpp"
 
+#include "karst/core/check.hpp"
 #include "karst/core/parallel.hpp"
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/face_links.hpp"
 #include "karst/pfem/fracture_stage.hpp"
 #include "karst/pfem/mesh_split.hpp"
 #include "karst/scene/wall_crossing.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <limits>
@@ -289,6 +292,14 @@ void remesh_structures(const Model& model, State& state) {
         }
         build(model, state, slot, new_rest_state);
         ++st.timings.remeshes;
+        // Particles that no longer form a tetrahedron were spread far apart by a load the
+        // material could not carry; a structure without elements would go on silently.
+        const Structure& rebuilt = st.structures[slot];
+        if (rebuilt.mesh.tet_count() == 0 && rebuilt.mesh.node_count() >= 4)
+            throw NumericalFailure(fmt::format(
+                "the remesh of a structure of {} nodes found no tetrahedra: its particles were "
+                "spread apart by a load far beyond what the material carries",
+                rebuilt.mesh.node_count()));
     }
 }
 

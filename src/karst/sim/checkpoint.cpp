@@ -139,7 +139,8 @@ template <class Ar>
 void fields(Ar& ar, RunRecord& r) {
     ar(r.next_frame, r.max_density_error, r.frame_density_error, r.frames_over_tolerance,
        r.particle_steps, r.frame_particle_steps, r.frame_step_seconds, r.wall_seconds,
-       r.energy_warned, r.removed_warned, r.biot_warned, r.initial, r.energy, r.profile, r.frames);
+       r.energy_warned, r.removed_warned, r.biot_warned, r.porous_removed_warned, r.initial,
+       r.energy, r.profile, r.frames);
 }
 
 namespace {

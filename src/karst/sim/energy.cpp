@@ -4,6 +4,8 @@
 #include "karst/rigid/fragment_motion.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace karst {
 
@@ -45,8 +47,14 @@ void EnergyAccount::add(const Energy& e) {
     m_released = std::max(m_released, m_start.total() - e.potential);
     m_largest_gain = std::max(m_largest_gain, e.total() - m_lowest);
     m_largest_rise = std::max(m_largest_rise, e.total() - m_start.total());
+    const Real gain = e.total() - m_lowest;
+    // With nothing released yet, any gain above round-off is more than 5 % of it.
+    const Real round_off = 1e-6 * (std::abs(m_start.kinetic) + std::abs(m_start.potential) +
+                                   std::abs(m_start.contact));
     if (m_released > 0)
-        m_worst_ratio = std::max(m_worst_ratio, (e.total() - m_lowest) / m_released);
+        m_worst_ratio = std::max(m_worst_ratio, gain / m_released);
+    else if (gain > round_off)
+        m_worst_ratio = std::numeric_limits<Real>::infinity();
     m_lowest = std::min(m_lowest, e.total());
 }
 

@@ -1,5 +1,7 @@
 #include "karst/sim/run.hpp"
 
+#include "karst/core/check.hpp"
+
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
@@ -266,9 +268,12 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
             record.energy_warned = true;
             progress.warn(fmt::format(
                 "t = {:.4g} s: the mechanical energy (kinetic, potential, contact) rose by "
-                "{:.3g} J, {:.0f} % of the {:.3g} J released so far (log.csv has the account)",
-                state.time, record.energy.largest_gain(), 100 * record.energy.worst_ratio(),
-                record.energy.released()));
+                "{:.3g} J, {} (log.csv has the account)",
+                state.time, record.energy.largest_gain(),
+                record.energy.released() > 0
+                    ? fmt::format("{:.0f} % of the {:.3g} J released so far",
+                                  100 * record.energy.worst_ratio(), record.energy.released())
+                    : std::string("with none released")));
         }
         if (!record.removed_warned && state.removed > 0) {
             record.removed_warned = true;
@@ -276,6 +281,13 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 "t = {:.4g} s: fluid left the domain: {} particles ({:.3g} kg) so far; stats.json "
                 "counts.removed has the total",
                 state.time, state.removed, state.removed * model.particle_mass));
+        }
+        if (!record.porous_removed_warned && state.porous.removed > 0) {
+            record.porous_removed_warned = true;
+            progress.warn(
+                fmt::format("t = {:.4g} s: porous particles left the domain: {} so far; stats.json "
+                            "counts.porous_removed has the total",
+                            state.time, state.porous.removed));
         }
         if (!record.biot_warned && state.structures.timings.unconverged_calls > 0) {
             record.biot_warned = true;
@@ -375,9 +387,15 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 if (porous) state.porous = last_good_porous;
                 state.time = last_good_time;
                 const std::vector<FrameLog>& written = out->history().log;
-                if (written.empty() || written.back().time < state.time)
-                    write_frame({state.time, dt, state.steps, state.fluid.size(),
-                                 record.frame_density_error, 0});
+                // The structures are not rolled back: where their solver is what failed, the
+                // frame is written as far as it goes, and the watchdog's error is the one shown.
+                try {
+                    if (written.empty() || written.back().time < state.time)
+                        write_frame({state.time, dt, state.steps, state.fluid.size(),
+                                     record.frame_density_error, 0});
+                } catch (const NumericalFailure& e) {
+                    progress.warn(fmt::format("the last good frame is incomplete: {}", e.what()));
+                }
                 throw;
             }
             record.max_density_error = std::max(record.max_density_error, report.max_density_error);

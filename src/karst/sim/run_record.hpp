@@ -23,7 +23,8 @@ struct RunRecord {
     Index frames_over_tolerance = 0;  ///< frames whose steps ended above the solve's tolerance
     double particle_steps = 0, frame_particle_steps = 0, frame_step_seconds = 0;
     double wall_seconds = 0;  ///< wall time of the run before it was resumed, s
-    bool energy_warned = false, removed_warned = false, biot_warned = false;
+    bool energy_warned = false, removed_warned = false, biot_warned = false,
+         porous_removed_warned = false;
     MassTotals initial;
     EnergyAccount energy;
     StepProfile profile;

@@ -5,6 +5,7 @@
 // start positions, so they run before anything moves (5-7).
 #include "karst/sim/step.hpp"
 
+#include "karst/core/check.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/coupling/fluid_reactions.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
@@ -47,16 +48,22 @@ constexpr Real k_step_density_error = 0.01;
 /// k_max_fracture_rounds while some node would move over a spacing in the call.
 constexpr int k_fracture_rounds = 4, k_max_fracture_rounds = 32;
 
+/// Runs one stage of the step at time t, timed into the profile; a numerical failure in it
+/// becomes the watchdog's error, naming the stage.
 template <class F>
-auto timed(StepProfile& profile, Stage stage, const F& f) {
+auto timed(StepProfile& profile, Real t, Stage stage, const F& f) {
     Stopwatch watch;
-    if constexpr (std::is_void_v<decltype(f())>) {
-        f();
-        profile[stage] += watch.seconds();
-    } else {
-        auto r = f();
-        profile[stage] += watch.seconds();
-        return r;
+    try {
+        if constexpr (std::is_void_v<decltype(f())>) {
+            f();
+            profile[stage] += watch.seconds();
+        } else {
+            auto r = f();
+            profile[stage] += watch.seconds();
+            return r;
+        }
+    } catch (const NumericalFailure& e) {
+        throw WatchdogError(k_stage_names[size_t(stage)], t, e.what());
     }
 }
 
@@ -147,21 +154,21 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     Real dt = dt_wanted;
 
     // 1. Neighbour search (and periodic Morton reordering of the fluid), porous pairs after.
-    timed(profile, Stage::Neighbours, [&] {
+    timed(profile, t, Stage::Neighbours, [&] {
         update_fluid_neighbours(model, state);
         if (porous) update_porous_neighbours(model, state);
     });
 
     // 2. Akinci volumes of the porous particles (§4.1), fluid densities with the boundary (M7),
     //    and the per-pair kernel gradient factors that the forces and the pressure solve share.
-    timed(profile, Stage::Density, [&] {
+    timed(profile, t, Stage::Density, [&] {
         if (porous) update_porous_boundary_volumes(model, state);
         update_density_and_pair_coefficients(model, state);
     });
     check_scalars(state.fluid.rho, id, Stage::Density, t, "density");
 
     // 3. Gravity, viscosity, surface tension, adhesion, boundary friction (§4.2).
-    timed(profile, Stage::NonPressureForces, [&] { compute_non_pressure_forces(model, state); });
+    timed(profile, t, Stage::NonPressureForces, [&] { compute_non_pressure_forces(model, state); });
     check_vectors(state.scratch.a_other, id, Stage::NonPressureForces, t, "acceleration");
 
     // 4. Pressure solve with walls and porous particles as boundary: DFSPH (divergence, then
@@ -173,7 +180,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
     const Real dt_sound = sound_crossing_time(fs, model.dx);
     PressureSolveReport pressure;
     bool converged = false;
-    timed(profile, Stage::PressureSolve, [&] {
+    timed(profile, t, Stage::PressureSolve, [&] {
         for (int halvings = 0;; ++halvings) {
             pressure = fs.solver == FluidSettings::Solver::Dfsph
                            ? solve_pressure_dfsph(model, state, dt)
@@ -193,7 +200,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
                                   dt_sound);
 
     // 10. Solute diffusion among fluid particles (M18), on this step's densities and lists.
-    timed(profile, Stage::SoluteDiffusion, [&] {
+    timed(profile, t, Stage::SoluteDiffusion, [&] {
         if (const Real needed = diffuse_solute(model, state, dt); needed > 0)
             throw WatchdogError(
                 k_stage_names[size_t(Stage::SoluteDiffusion)], state.time,
@@ -206,36 +213,36 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
 
     if (porous) {
         // 3b. The fluid's last pressure, friction and adhesion act back on the porous particles.
-        timed(profile, Stage::FluidReactions, [&] { compute_fluid_reactions(model, state); });
+        timed(profile, t, Stage::FluidReactions, [&] { compute_fluid_reactions(model, state); });
         // 8. Pore flow, absorption and drained fluid (§4.7), before anything moves.
-        timed(profile, Stage::PoreFlow, [&] { pore_flow_and_absorption(model, state, dt); });
+        timed(profile, t, Stage::PoreFlow, [&] { pore_flow_and_absorption(model, state, dt); });
         check_scalars(state.porous.particles.absorbed_mass, {}, Stage::PoreFlow, t,
                       "absorbed mass");
     }
 
     // 5. Symplectic Euler; particles leaving the domain, or drained, are removed (§4.4).
     state.a_max =
-        timed(profile, Stage::Integrate, [&] { return integrate_fluid(model, state, dt); });
+        timed(profile, t, Stage::Integrate, [&] { return integrate_fluid(model, state, dt); });
     check_vectors(state.fluid.v, state.fluid.id, Stage::Integrate, t + dt, "velocity",
                   model.scene.max_speed);
     check_vectors(state.fluid.x, state.fluid.id, Stage::Integrate, t + dt, "position");
 
     if (porous) {
         // 6-7. Fragments: contacts, rigid integration, members follow (§4.5).
-        timed(profile, Stage::Fragments, [&] { advance_fragments(model, state, dt); });
+        timed(profile, t, Stage::Fragments, [&] { advance_fragments(model, state, dt); });
         // 11a. Loads of the next Biot call (§5.3): this step's forces on the porous particles,
         //      the fluid's reactions and the contacts, summed over the call's interval (here,
         //      while the force array still matches the particles dissolution may remove).
-        timed(profile, Stage::Structure, [&] { add_structure_loads(state, dt); });
+        timed(profile, t, Stage::Structure, [&] { add_structure_loads(state, dt); });
         // 9. Dissolution into muddy fluid (§4.8); the fragments' mass properties follow the
         //    pore water and the members they lost.
-        timed(profile, Stage::Dissolution, [&] {
+        timed(profile, t, Stage::Dissolution, [&] {
             dissolve_particles(model, state);
             refresh_fragment_mass(state, model.dx);
         });
         // 12. Wet fragments in slow contact merge (§5.6, Fig. 7); one merged into an anchored
         //     fragment joins its structure at the next Biot call's remesh.
-        timed(profile, Stage::Fracture, [&] {
+        timed(profile, t, Stage::Fracture, [&] {
             if (!merge_fragments(model, state)) return;
             state.porous_scratch.pairs_stale = true;
             refresh_fragment_mass(state, model.dx);
@@ -247,7 +254,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         //     Fracture (§5.5-5.6) tests the call's stress before the feedback reads it; a
         //     structure that cracked is solved again at once under the same loads (§4.10), and
         //     tested again, so that a crack runs as far as the load drives it within the call.
-        const bool called = timed(profile, Stage::Structure, [&] {
+        const bool called = timed(profile, t, Stage::Structure, [&] {
             follow_structure_displacement(model, state);
             if (!biot_call_due(model, state)) return false;
             remesh_structures(model, state);
@@ -261,15 +268,15 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
             for (int round = 0; round < k_max_fracture_rounds; ++round) {
                 if (round >= k_fracture_rounds && largest_call_displacement(state) <= model.dx)
                     break;
-                if (!timed(profile, Stage::Fracture,
+                if (!timed(profile, t, Stage::Fracture,
                            [&] { return fracture_structures(model, state, t + dt); }))
                     break;
                 state.porous_scratch.pairs_stale = true;
-                timed(profile, Stage::Structure,
+                timed(profile, t, Stage::Structure,
                       [&] { solve_structures(model, state, t + dt, true); });
                 check_structures(state.structures, Stage::Structure, t + dt);
             }
-            timed(profile, Stage::Structure, [&] {
+            timed(profile, t, Stage::Structure, [&] {
                 end_biot_call(state);
                 if (feed_back_structures(model, state)) state.porous_scratch.pairs_stale = true;
                 release_split_solvers(state);
@@ -277,6 +284,10 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
         }
         check_vectors(state.porous.particles.x, state.porous.particles.id, Stage::Structure, t + dt,
                       "porous position");
+        // The speed limit holds for the solid too: a fragment thrown through a wall in one
+        // step would otherwise leave the domain and vanish.
+        check_vectors(state.porous.particles.v, state.porous.particles.id, Stage::Fragments, t + dt,
+                      "porous velocity", model.scene.max_speed);
     }
 
     state.time = t + dt;
