@@ -196,6 +196,12 @@ TEST(EnergyAccount, AGainWithNothingReleasedIsReported) {
     a.add({3.9, 80});  // a dissolving block that made 3.9 J while nothing fell
     EXPECT_DOUBLE_EQ(a.released(), 0);
     EXPECT_TRUE(a.gained_more_than(0.05));
+    // Water at z = 0 in zero gravity: nothing to scale round-off by; under 1 mJ is not reported.
+    EnergyAccount b({0, 0});
+    b.add({5e-4, 0});
+    EXPECT_FALSE(b.gained_more_than(0.05));
+    b.add({2e-3, 0});
+    EXPECT_TRUE(b.gained_more_than(0.05));
 }
 
 }  // namespace

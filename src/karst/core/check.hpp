@@ -13,7 +13,7 @@ struct InternalError : std::runtime_error {
 
 /// A numerical method failed on what the input made of it (a singular stiffness matrix, a
 /// solver that did not converge): not a bug. The step turns it into a WatchdogError naming the
-/// stage and time, so the run stops loudly and keeps its last good frame and stats.json.
+/// stage and time, and the run ends on either loudly, with stats.json.
 struct NumericalFailure : std::runtime_error {
     using std::runtime_error::runtime_error;
 };

@@ -290,12 +290,15 @@ void remesh_structures(const Model& model, State& state) {
         } else {
             continue;
         }
+        const Index tets_before = s.mesh.tet_count();
         build(model, state, slot, new_rest_state);
         ++st.timings.remeshes;
-        // Particles that no longer form a tetrahedron were spread far apart by a load the
-        // material could not carry; a structure without elements would go on silently.
+        // A distorted body rebuilt on its deformed positions that no longer forms a single
+        // tetrahedron was spread apart by a load the material could not carry: without
+        // elements it would go on silently. (A body that lost nodes keeps its lattice rest
+        // positions; a last flat layer of a dissolving block may rightly have no element.)
         const Structure& rebuilt = st.structures[slot];
-        if (rebuilt.mesh.tet_count() == 0 && rebuilt.mesh.node_count() >= 4)
+        if (new_rest_state && tets_before > 0 && rebuilt.mesh.tet_count() == 0)
             throw NumericalFailure(fmt::format(
                 "the remesh of a structure of {} nodes found no tetrahedra: its particles were "
                 "spread apart by a load far beyond what the material carries",

@@ -48,9 +48,12 @@ void EnergyAccount::add(const Energy& e) {
     m_largest_gain = std::max(m_largest_gain, e.total() - m_lowest);
     m_largest_rise = std::max(m_largest_rise, e.total() - m_start.total());
     const Real gain = e.total() - m_lowest;
-    // With nothing released yet, any gain above round-off is more than 5 % of it.
+    // With nothing released yet, a gain above round-off (and above 1 mJ, since the potential's
+    // origin is arbitrary and energies that the account leaves out, such as surface tension's,
+    // may move a little) is more than any share of it.
     const Real round_off = 1e-6 * (std::abs(m_start.kinetic) + std::abs(m_start.potential) +
-                                   std::abs(m_start.contact));
+                                   std::abs(m_start.contact)) +
+                           1e-3;
     if (m_released > 0)
         m_worst_ratio = std::max(m_worst_ratio, gain / m_released);
     else if (gain > round_off)

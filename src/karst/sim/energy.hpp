@@ -36,7 +36,8 @@ public:
     Real largest_gain() const { return m_largest_gain; }
     /// Largest rise of the total above its start, J.
     Real largest_rise_over_start() const { return m_largest_rise; }
-    /// True once a rise exceeded `fraction` of the energy released by then.
+    /// True once a rise exceeded `fraction` of the energy released by then (while nothing was
+    /// released, once a rise exceeded round-off and 1 mJ).
     bool gained_more_than(Real fraction) const { return m_worst_ratio > fraction; }
     Real worst_ratio() const { return m_worst_ratio; }
 

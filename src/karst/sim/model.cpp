@@ -68,9 +68,9 @@ double available_memory_bytes() {
 }
 
 /// The neighbour grid covers the domain: the scene's, or the box around every shape (walls with
-/// their layers) grown by 4 h as build_model makes it. Checked before any sampling, whose cost
-/// grows with a shape's box: a union of two spheres 300 m apart sampled for an hour. h = 2 dx as
-/// in build_model.
+/// their layers) grown by 4 h, which holds the box build_model makes around the particles. Checked
+/// before any sampling, whose cost grows with a shape's box: a union of two spheres 300 m apart
+/// sampled for an hour. h = 2 dx as in build_model.
 void check_domain_grid(const Scene& s, Real h) {
     if (s.domain) {
         (void)UniformGrid(*s.domain, h);  // refuses at /domain
@@ -388,9 +388,6 @@ void set_up_porous_materials(Model& m) {
     m.porous_grid = UniformGrid(m.domain, reach);
 }
 
-/// The Biot problems a scene can pose (docs/method.md §5): a poroelastic-only solid needs pores,
-/// and in a coupled scene only anchored fragments of permeable solids get one, so constraints on
-/// any other solid would be silently ignored.
 /// A solid that gets a Biot problem must mesh into tetrahedra: particles on at least two lattice
 /// planes along every axis (one particle, or a one-layer sheet, gives no element).
 void check_meshable(const Model& m, const PorousBody& body) {
@@ -406,6 +403,9 @@ void check_meshable(const Model& m, const PorousBody& body) {
                         (box.max - box.min)[0], (box.max - box.min)[1], (box.max - box.min)[2]));
 }
 
+/// The Biot problems a scene can pose (docs/method.md §5): a poroelastic-only solid needs pores,
+/// and in a coupled scene only anchored fragments of permeable solids get one, so constraints on
+/// any other solid would be silently ignored.
 void check_biot_setup(const Model& m) {
     const Scene& scene = m.scene;
     for (const PorousBody& body : m.porous) {

@@ -387,14 +387,14 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                 if (porous) state.porous = last_good_porous;
                 state.time = last_good_time;
                 const std::vector<FrameLog>& written = out->history().log;
-                // The structures are not rolled back: where their solver is what failed, the
-                // frame is written as far as it goes, and the watchdog's error is the one shown.
+                // The structures are not rolled back: where their solver is what failed, writing
+                // the frame fails too, and the watchdog's error stays the one reported.
                 try {
                     if (written.empty() || written.back().time < state.time)
                         write_frame({state.time, dt, state.steps, state.fluid.size(),
                                      record.frame_density_error, 0});
-                } catch (const NumericalFailure& e) {
-                    progress.warn(fmt::format("the last good frame is incomplete: {}", e.what()));
+                } catch (const std::exception& e) {
+                    progress.warn(fmt::format("the last good frame was not written: {}", e.what()));
                 }
                 throw;
             }
@@ -432,7 +432,11 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                  porous ? live_fragments(state) : 0});
             if (stop_signal()) break;  // after a whole step: the folder stays consistent
         }
-    } catch (const WatchdogError& e) {
+    } catch (const std::runtime_error& e) {
+        // The watchdog's stop, or a numerical failure outside a step (a frame's structure
+        // solve): the run ends loudly with stats.json. Other errors propagate.
+        if (!dynamic_cast<const WatchdogError*>(&e) && !dynamic_cast<const NumericalFailure*>(&e))
+            throw;
         progress.finish();
         result.ok = false;
         result.failure = e.what();
