@@ -1,7 +1,6 @@
 #include "karst/pfem/amg_solver.hpp"
 
 #include "karst/core/check.hpp"
-
 #include "karst/core/timer.hpp"
 
 #include <HYPRE.h>

@@ -169,8 +169,7 @@ double estimate_lattice_count(const Shape& shape, Real dx, Real lo, Real hi, dou
     const Real reach = std::isfinite(hi) ? std::max(hi, Real(0)) : 0;
     LatticeIndex a, b;
     lattice_range(shape.bounds(), reach, dx, a, b);
-    double lattice_points = 1;
-    for (int d = 0; d < 3; ++d) lattice_points *= double(b[d] - a[d] + 1);
+    const double lattice_points = range_points(a, b);
     if (lattice_points > 2e8)
         return coarse_lattice_count(shape, reach, lo, hi, lattice_points, true);
     // A large box whose coarse lower bound already exceeds `enough` needs no exact count.

@@ -1,7 +1,6 @@
 #include "karst/scene/validate.hpp"
 
 #include "karst/scene/read_json.hpp"
-
 #include "karst/scene/scene_error.hpp"
 #include "karst/scene/schema.hpp"
 

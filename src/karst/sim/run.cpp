@@ -1,7 +1,6 @@
 #include "karst/sim/run.hpp"
 
 #include "karst/core/check.hpp"
-
 #include "karst/core/parallel.hpp"
 #include "karst/core/timer.hpp"
 #include "karst/coupling/porous_boundary_volumes.hpp"
@@ -368,6 +367,16 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
         return s;
     };
 
+    // The run ends loudly on a watchdog stop or a numerical failure, with stats.json.
+    const auto stopped_by = [&](const std::exception& e) {
+        progress.finish();
+        result.ok = false;
+        result.failure = e.what();
+        result.stats = stats();
+        result.stats["failure"] = e.what();
+        out->write_stats(result.stats);
+        return result;
+    };
     try {
         while (state.time < end - 1e-12 * std::max(Real(1), end)) {
             const Real frame_time = std::min(end, record.next_frame * frame_dt);
@@ -432,18 +441,10 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
                  porous ? live_fragments(state) : 0});
             if (stop_signal()) break;  // after a whole step: the folder stays consistent
         }
-    } catch (const std::runtime_error& e) {
-        // The watchdog's stop, or a numerical failure outside a step (a frame's structure
-        // solve): the run ends loudly with stats.json. Other errors propagate.
-        if (!dynamic_cast<const WatchdogError*>(&e) && !dynamic_cast<const NumericalFailure*>(&e))
-            throw;
-        progress.finish();
-        result.ok = false;
-        result.failure = e.what();
-        result.stats = stats();
-        result.stats["failure"] = e.what();
-        out->write_stats(result.stats);
-        return result;
+    } catch (const WatchdogError& e) {
+        return stopped_by(e);
+    } catch (const NumericalFailure& e) {  // outside a step: a frame's structure solve
+        return stopped_by(e);
     }
     if (record.frames_over_tolerance > 0)
         progress.warn(fmt::format(
