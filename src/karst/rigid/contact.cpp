@@ -12,6 +12,7 @@ ContactLaw ContactLaw::for_fragments(Real spacing, Real fragment_mass, Real grav
                                      Real particle_mass, Real restitution) {
     ContactLaw law;
     law.rest_distance = spacing;
+    law.restitution = restitution;
     law.stiffness = fragment_mass * gravity / (0.01 * spacing);
     // A damped oscillator of reduced mass m/2 rebounds with e = exp(-pi zeta / sqrt(1 - zeta^2)).
     const Real log_e = std::log(restitution);

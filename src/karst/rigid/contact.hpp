@@ -18,6 +18,7 @@ struct ContactLaw {
     Real rest_distance = 0.02;  ///< d0 = dx, m
     Real stiffness = 0;         ///< k_c, N/m
     Real damping = 0;           ///< c_c, N s/m
+    Real restitution = 0;       ///< e, the normal restitution c_c was made for
     /// k_c = M g / (0.01 dx) for a fragment of mass M (docs/method.md §4.2), and the
     /// damping that gives a normal restitution e for two particles of mass m_pair each.
     static ContactLaw for_fragments(Real spacing, Real fragment_mass, Real gravity,

@@ -2,6 +2,7 @@
 
 #include "karst/core/parallel.hpp"
 #include "karst/core/soa.hpp"
+#include "karst/rigid/closing_speed_limit.hpp"
 #include "karst/rigid/contact.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -148,6 +149,8 @@ void advance_fragments(const Model& model, State& state, Real dt) {
         // [D] The springs are explicit: a light fragment pressed between others rang up and
         // flew off with energy it never had, so the contacts take sub-steps short enough for
         // the stiffest contact mode, under the step's fixed fluid reactions.
+        // Fast approaches first, which the springs would let through the wall's layer.
+        limit_closing_speeds(model, state, law, dt);
         const Real omega = contact_frequency(model, state, law, dt);
         const int substeps =
             omega > 0 ? std::max(1, int(std::ceil(dt / contact_sub_step(omega, law) - 1e-9))) : 1;
