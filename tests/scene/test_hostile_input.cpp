@@ -102,6 +102,12 @@ TEST(HostileInput, MessagesNameKeysWithoutEchoingThemRaw) {
     const SceneError c =
         test::refuse_scene(fluid_scene(k_box, ",\"" + std::string(1 << 20, 'k') + "\":1"));
     EXPECT_LT(std::string(c.what()).size(), 2000u);
+    // A long key of two-byte characters is cut between characters: the message stays UTF-8.
+    std::string accents = "a";
+    for (int i = 0; i < 70; ++i) accents += "\u00e9";
+    const SceneError u = test::refuse_scene(fluid_scene(k_box, ",\"" + accents + "\":1"));
+    EXPECT_NO_THROW((void)nlohmann::json(std::string(u.what())).dump()) << "valid UTF-8";
+    EXPECT_NE(u.path.find("... (141 bytes)"), std::string::npos) << u.path;
     // A misspelt shape type is named as the unknown key it is.
     const SceneError d =
         test::refuse_scene(fluid_scene(R"({"typ":"box","min":[0,0,0],"max":[0.2,0.2,0.2]})"));
@@ -313,6 +319,24 @@ TEST(HostileInput, NonFiniteBiotFieldsStopTheRunNamingTheNode) {
     EXPECT_NE(r.failure.find("non-finite displacement (Biot)"), std::string::npos) << r.failure;
     EXPECT_NE(r.failure.find("stage 'structure' at particle"), std::string::npos);
     EXPECT_GT(r.stats["biot"]["unconverged_calls"].get<int>(), 0);
+}
+
+TEST(HostileInput, ABiotStepLongerThanTheRunIsToldNotIgnored) {
+    // It ran to its end with biot.calls 0 and said nothing.
+    const std::string scene = R"({"name": "biot_never", "particle_spacing": 0.05,
+      "time": {"end": 0.1},
+      "porous_solids": [{"shape": {"type": "box", "min": [0,0,0], "max": [0.2,0.2,0.2]},
+        "constraints": [{"kind": "fixed", "region": {"type": "box", "min": [-1,-1,-1], "max": [2,2,0.01]}}]}],
+      "poroelastic": {"time_step": )";
+    for (const char* time_step : {"0.5", "0.04"}) {
+        testing::internal::CaptureStderr();
+        const RunResult r = run_quietly(scene + time_step + "}}", "biot_never");
+        const std::string told = testing::internal::GetCapturedStderr();
+        ASSERT_TRUE(r.ok) << r.failure;
+        const bool never = r.stats["biot"]["calls"].get<int>() == 0;
+        EXPECT_EQ(never, std::string(time_step) == "0.5");
+        EXPECT_EQ(told.find("the Biot solver never runs") != std::string::npos, never) << told;
+    }
 }
 
 TEST(HostileInput, PoreWaterTooStiffForItsMobilityStopsTheRun) {

@@ -9,7 +9,8 @@ namespace karst {
 
 /// Stage: cuts fast closings (rigid/closing_speed_limit.hpp), then adds contact forces to
 /// state.porous_scratch.force, integrates every free fragment under those forces and gravity,
-/// then moves its members: x = c + R X, v = v_c + omega x (x - c), K = R K0 R^T (M12). Porous particles leaving the domain are removed and counted.
+/// then moves its members: x = c + R X, v = v_c + omega x (x - c), K = R K0 R^T (M12). Porous
+/// particles leaving the domain are removed and counted.
 void advance_fragments(const Model& model, State& state, Real dt);
 
 /// Where each porous particle meets the others by contact: a member of an anchored structure on

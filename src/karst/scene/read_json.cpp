@@ -92,11 +92,20 @@ private:
 
 }  // namespace
 
+std::string utf8_prefix(const std::string& text, size_t bytes) {
+    size_t end = std::min(text.size(), bytes);
+    // Back off from continuation bytes (10xxxxxx) to the first byte of their character.
+    while (end < text.size() && end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80)
+        --end;
+    return text.substr(0, end);
+}
+
 std::string json_pointer_token(const std::string& key) {
     constexpr size_t k_longest = 64;
+    const std::string kept = utf8_prefix(key, k_longest);
     std::string out;
-    for (size_t i = 0; i < key.size() && i < k_longest; ++i) {
-        const unsigned char c = static_cast<unsigned char>(key[i]);
+    for (size_t i = 0; i < kept.size(); ++i) {
+        const unsigned char c = static_cast<unsigned char>(kept[i]);
         if (c == '~')
             out += "~0";
         else if (c == '/')

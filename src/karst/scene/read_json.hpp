@@ -20,4 +20,7 @@ nlohmann::json read_scene_json(const std::string& text);
 /// terminal escapes or a megabyte of key.
 std::string json_pointer_token(const std::string& key);
 
+/// The longest start of `text` of at most `bytes` bytes that ends on a whole UTF-8 character.
+std::string utf8_prefix(const std::string& text, size_t bytes);
+
 }  // namespace karst

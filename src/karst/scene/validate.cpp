@@ -103,7 +103,7 @@ private:
         std::string expected = best.empty() ? "one of the keys " + allowed
                                             : "a known key (did you mean \"" + best + "\"?)";
         std::string shown = json(name).dump();  // quoted, control characters escaped
-        if (shown.size() > 70) shown = shown.substr(0, 67) + "...";
+        if (shown.size() > 70) shown = utf8_prefix(shown, 67) + "...";
         throw SceneError(path + "/" + json_pointer_token(name), expected, "unknown key " + shown);
     }
 

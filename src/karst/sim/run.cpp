@@ -256,6 +256,11 @@ RunResult run_simulation(const Scene& scene_in, const RunOptions& opt) {
     const bool fluid_frames = !model.poroelastic_only();
 
     ProgressLine progress(opt.quiet);
+    if (meshes && time_to_next_biot_call(model, state) > scene.time.end - state.time)
+        progress.warn(fmt::format(
+            "/poroelastic/time_step = {:g} s is longer than what is left of the run ({:g} s): "
+            "the Biot solver never runs, so the solids neither deform nor crack",
+            scene.poroelastic.time_step, scene.time.end - state.time));
     PorousSurfaces porous_surfaces;  // each fragment's triangles, kept while its members stay
     auto write_frame = [&](FrameLog log) {
         const Energy e = mechanical_energy(model, state);
