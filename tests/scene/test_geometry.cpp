@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <numbers>
+#include <utility>
 
 namespace karst {
 namespace {
@@ -25,6 +26,30 @@ TEST(Geometry, SampledVolumesMatchShapes) {
     Shape uni{Shape::Kind::Union, {}, {}, 0, {box, sphere}};
     // Inclusion-exclusion: |box u sphere| = |sphere| + |box - sphere|.
     EXPECT_EQ(double(sample_lattice(uni, dx, -INFINITY, 0).size()), n + d);
+}
+
+TEST(Geometry, FarApartPartsGiveTheSamePointsAsTheWholeBox) {
+    // Two spheres 3 m apart, less a box through the first, at dx 0.05: the difference is sampled
+    // in its union's parts' boxes (not the 3.2 m box), solid and a skin outside alike, and gives
+    // the whole box's points in the same order.
+    const Real dx = 0.05;
+    const Shape first{Shape::Kind::Sphere, Vec3(0, 0, 0), Vec3::Zero(), 0.2, {}};
+    const Shape second{Shape::Kind::Sphere, Vec3(3, 3, 3), Vec3::Zero(), 0.2, {}};
+    const Shape cut{Shape::Kind::Box, Vec3(-0.05, -0.3, -0.3), Vec3(0.05, 0.3, 0.3), 0, {}};
+    const Shape both{Shape::Kind::Union, Vec3::Zero(), Vec3::Zero(), 0, {first, second}};
+    const Shape diff{Shape::Kind::Difference, Vec3::Zero(), Vec3::Zero(), 0, {both, cut}};
+    for (const auto& [lo, hi] : {std::pair<Real, Real>{-INFINITY, 0}, {0, 2 * dx}}) {
+        std::vector<LatticeIndex> whole;  // [-10, 70]^3 holds the box, grown by the skin
+        for (std::int64_t k = -10; k <= 70; ++k)
+            for (std::int64_t j = -10; j <= 70; ++j)
+                for (std::int64_t i = -10; i <= 70; ++i) {
+                    const Real d = diff.signed_distance(lattice_point({i, j, k}, dx));
+                    if (d > lo && d <= hi) whole.push_back({i, j, k});
+                }
+        const std::vector<LatticeIndex> parts = sample_lattice(diff, dx, lo, hi);
+        EXPECT_GT(parts.size(), 0u);
+        EXPECT_EQ(parts, whole);
+    }
 }
 
 TEST(Geometry, SkinOfAContainerAndEstimate) {

@@ -103,6 +103,17 @@ double range_points(const LatticeIndex& a, const LatticeIndex& b) {
     return n;
 }
 
+/// Boxes that hold every point of `shape`: a union's parts' boxes, a difference's first shape's
+/// (the shapes it subtracts only remove points), and any other shape's own box.
+void part_boxes(const Shape& shape, std::vector<Aabb>& boxes) {
+    if (shape.kind == Shape::Kind::Union)
+        for (const Shape& c : shape.children) part_boxes(c, boxes);
+    else if (shape.kind == Shape::Kind::Difference)
+        part_boxes(shape.children.front(), boxes);
+    else
+        boxes.push_back(shape.bounds());
+}
+
 }  // namespace
 
 std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, Real hi) {
@@ -110,15 +121,18 @@ std::vector<LatticeIndex> sample_lattice(const Shape& shape, Real dx, Real lo, R
     LatticeIndex a, b;
     lattice_range(shape.bounds(), reach, dx, a, b);
     std::vector<LatticeIndex> out;
-    // A union whose parts lie far apart: visit only each part's box (grown by the band's
-    // reach, which holds every point of the union's band near that part), then drop the points
-    // two boxes share. Sorted in (k, j, i) order, the result is that of the single box.
-    if (shape.kind == Shape::Kind::Union) {
+    // Parts that lie far apart (a union's, also inside a difference): visit only each part's
+    // box, grown by the band's reach (every point of the band lies within reach of the shape's
+    // surface, so of some part's box), then drop the points two boxes share. Sorted in (k, j, i)
+    // order, the result is that of the single box.
+    std::vector<Aabb> boxes;
+    part_boxes(shape, boxes);
+    if (boxes.size() > 1) {
         std::vector<std::pair<LatticeIndex, LatticeIndex>> parts;
         double part_points = 0;
-        for (const Shape& c : shape.children) {
+        for (const Aabb& box : boxes) {
             LatticeIndex ca, cb;
-            lattice_range(c.bounds(), reach, dx, ca, cb);
+            lattice_range(box, reach, dx, ca, cb);
             parts.push_back({ca, cb});
             part_points += range_points(ca, cb);
         }
