@@ -159,6 +159,18 @@ TEST(HostileInput, ASolidThatCannotMeshIsRefusedWhereItGetsABiotProblem) {
         EXPECT_NE(e.expected.find("two particles thick"), std::string::npos) << e.what();
     }
     EXPECT_NO_THROW(build_model(parse_scene(solid("[0.1,0.1,0.1]"))));
+    // A thin rod along the diagonal: its particles touch only at cube corners, and it ran with
+    // 0 elements and "all_converged". Twice as thick, it meshes.
+    const auto rod = [](double radius) {
+        return fmt::format(
+            R"({{"name":"t","particle_spacing":0.05,"porous_solids":[{{"shape":{{"type":)"
+            R"("cylinder","base":[0,0,0],"top":[0.8,0.8,0.8],"radius":{}}}}}]}})",
+            radius);
+    };
+    const SceneError thin = test::refuse_scene(rod(0.03));
+    EXPECT_EQ(thin.path, "/porous_solids/0/shape");
+    EXPECT_NE(thin.expected.find("off one plane"), std::string::npos) << thin.what();
+    EXPECT_NO_THROW(build_model(parse_scene(rod(0.05))));
 }
 
 TEST(HostileInput, GeometryBeyondTheLatticeIsRefusedBeforeCounting) {

@@ -390,17 +390,52 @@ void set_up_porous_materials(Model& m) {
 
 /// A solid that gets a Biot problem must mesh into tetrahedra: particles on at least two lattice
 /// planes along every axis (one particle, or a one-layer sheet, gives no element).
+/// Whether some cube of the lattice holds four particles of `points` off one plane, so that the
+/// Delaunay mesh of the solid has a tetrahedron no larger than a lattice cell's (its
+/// circumsphere, the cell's, holds no other lattice point). A sheet one particle thick, a line,
+/// and a rod along a diagonal, whose particles touch only at corners, have none.
+bool holds_a_lattice_cell_tetrahedron(const std::vector<Vec3>& points, Real dx) {
+    const auto index = [&](const Vec3& x) {
+        return LatticeIndex{std::llround(x[0] / dx - 0.5), std::llround(x[1] / dx - 0.5),
+                            std::llround(x[2] / dx - 0.5)};
+    };
+    struct Hash {
+        size_t operator()(const LatticeIndex& i) const {
+            return std::hash<std::int64_t>()(i[0] * 73856093 ^ i[1] * 19349663 ^ i[2] * 83492791);
+        }
+    };
+    std::unordered_set<LatticeIndex, Hash> occupied;
+    for (const Vec3& x : points) occupied.insert(index(x));
+    for (const LatticeIndex& p : occupied)
+        for (int corner = 0; corner < 8; ++corner) {
+            // The cube whose corner `corner` is p; its occupied vertices.
+            const LatticeIndex base{p[0] - (corner & 1), p[1] - (corner >> 1 & 1),
+                                    p[2] - (corner >> 2 & 1)};
+            std::vector<Vec3> in;  // cube-local coordinates
+            for (int v = 0; v < 8; ++v)
+                if (occupied.count(
+                        {base[0] + (v & 1), base[1] + (v >> 1 & 1), base[2] + (v >> 2 & 1)}))
+                    in.push_back(Vec3(v & 1, v >> 1 & 1, v >> 2 & 1));
+            for (size_t a = 1; a < in.size(); ++a)
+                for (size_t b = a + 1; b < in.size(); ++b)
+                    for (size_t c = b + 1; c < in.size(); ++c)
+                        if ((in[a] - in[0]).cross(in[b] - in[0]).dot(in[c] - in[0]) != 0)
+                            return true;
+        }
+    return false;
+}
+
 void check_meshable(const Model& m, const PorousBody& body) {
+    if (holds_a_lattice_cell_tetrahedron(body.rest_x, m.dx)) return;
     Aabb box;
     for (const Vec3& x : body.rest_x) box.extend(x);
     const PorousSolid& s = m.scene.porous_solids[body.solid];
-    if (box.empty() || ((box.max - box.min).array() < 0.5 * m.dx).any())
-        throw SceneError(
-            s.path + "/shape",
-            "a solid at least two particles thick along every axis (its Biot "
-            "problem needs tetrahedra)",
-            fmt::format("{} particles spanning {:.3g} x {:.3g} x {:.3g} m", body.rest_x.size(),
-                        (box.max - box.min)[0], (box.max - box.min)[1], (box.max - box.min)[2]));
+    throw SceneError(
+        s.path + "/shape",
+        "a solid at least two particles thick along every axis, with four particles off one plane "
+        "in some lattice cell (its Biot problem needs tetrahedra)",
+        fmt::format("{} particles spanning {:.3g} x {:.3g} x {:.3g} m", body.rest_x.size(),
+                    (box.max - box.min)[0], (box.max - box.min)[1], (box.max - box.min)[2]));
 }
 
 /// The Biot problems a scene can pose (docs/method.md §5): a poroelastic-only solid needs pores,
