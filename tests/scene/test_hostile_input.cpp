@@ -171,6 +171,19 @@ TEST(HostileInput, ASolidThatCannotMeshIsRefusedWhereItGetsABiotProblem) {
     EXPECT_EQ(thin.path, "/porous_solids/0/shape");
     EXPECT_NE(thin.expected.find("off one plane"), std::string::npos) << thin.what();
     EXPECT_NO_THROW(build_model(parse_scene(rod(0.05))));
+    // An alpha that keeps no lattice cell's tetrahedron (radius sqrt(3)/2 dx; orthoradius
+    // sqrt(0.45) dx when weighted): every solid meshed with 0 elements.
+    const auto with_alpha = [&](const char* alpha, const char* weighted) {
+        return R"({"name":"t","particle_spacing":0.05,"porous_solids":[{"shape":{"type":"box",)"
+               R"("min":[0,0,0],"max":[0.3,0.3,0.3]}}],"poroelastic":{"alpha":)" +
+               std::string(alpha) + R"(,"weighted_alpha":)" + weighted + "}}";
+    };
+    for (const auto& [alpha, weighted] : {std::pair{"0.8", "false"}, {"0.65", "true"}}) {
+        const SceneError e = test::refuse_scene(with_alpha(alpha, weighted));
+        EXPECT_EQ(e.path, "/poroelastic/alpha") << alpha;
+    }
+    EXPECT_NO_THROW(build_model(parse_scene(with_alpha("0.9", "false"))));
+    EXPECT_NO_THROW(build_model(parse_scene(with_alpha("0.7", "true"))));
 }
 
 TEST(HostileInput, GeometryBeyondTheLatticeIsRefusedBeforeCounting) {

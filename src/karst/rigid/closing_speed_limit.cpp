@@ -14,10 +14,12 @@ namespace {
 /// not move).
 struct SpeculativePair {
     Index a = 0, b = -1;
-    Vec3 normal = Vec3::Zero();                       ///< from the other towards k
+    Index still_member = -1;     ///< the anchored structure's member on the other side, if any
+    Vec3 normal = Vec3::Zero();  ///< from the other towards k
     Vec3 arm_a = Vec3::Zero(), arm_b = Vec3::Zero();  ///< contact point - centre
-    Real target = 0;    ///< the slowest allowed normal velocity, m/s (<= 0: closing)
-    Real approach = 0;  ///< the closing speed before the solve, m/s (> 0)
+    Real target = 0;      ///< the slowest allowed normal velocity, m/s (<= 0: closing)
+    Real approach = 0;    ///< the closing speed before the solve, m/s
+    bool impact = false;  ///< closing fast enough to pass the core from its rest length
     Real inverse_mass = 0;
     Real impulse = 0;  ///< accumulated, N s (>= 0)
 };
@@ -26,7 +28,8 @@ constexpr int k_sweeps = 20;
 
 }  // namespace
 
-Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& law, Real dt) {
+Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& law, Real dt,
+                           std::vector<Vec3>& still_impulse) {
     PorousParticles& p = state.porous.particles;
     std::vector<Fragment>& fragments = state.porous.fragments;
     const PorousScratch& s = state.porous_scratch;
@@ -56,21 +59,28 @@ Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& l
         const Vec3 gravity_b = c.b >= 0 ? g : Vec3::Zero();
         return c.normal.dot(velocity(c.a, c.arm_a) - velocity(c.b, c.arm_b) + dt * (g - gravity_b));
     };
-    // The pairs, in member order (each pair of two free fragments once, from its lower index).
+    // The pairs, in member order (each pair of two free fragments once, from its lower index):
+    // those that would pass the core, and those that touch, which an impulse elsewhere in
+    // their fragment can set closing.
     std::vector<SpeculativePair> pairs;
-    const auto consider = [&](Index k, const Vec3& other_x, Index other_fragment, Real rest) {
+    bool any_passes = false;
+    const auto consider = [&](Index k, const Vec3& other_x, Index other_fragment,
+                              Index still_member, Real rest) {
         const Index a = p.fragment[k];
         const Vec3 d = x[k] - other_x;
         const Real r = d.norm();
         if (r == 0) return;
         SpeculativePair c;
-        c.a = a, c.b = other_fragment, c.normal = d / r;
+        c.a = a, c.b = other_fragment, c.still_member = still_member, c.normal = d / r;
         c.arm_a = x[k] - fragments[a].centre;
         if (c.b >= 0) c.arm_b = other_x - fragments[c.b].centre;
         const Real closing = closing_speed(c);
         c.target = std::min(Real(0), -(r - k_contact_core * rest) / dt);
-        if (closing >= c.target) return;  // it stays outside the core over this step
+        const bool passes = closing < c.target;
+        if (!passes && r >= rest) return;
+        any_passes |= passes;
         c.approach = -closing;
+        c.impact = passes && c.approach > (1 - k_contact_core) * rest / dt;
         c.inverse_mass = response(a, c.arm_a, c.normal) + response(c.b, c.arm_b, c.normal);
         pairs.push_back(c);
     };
@@ -79,7 +89,7 @@ Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& l
         const Index a = p.fragment[k];
         if (!is_free(a) || law.pair_scale(a, a) == 0) continue;
         s.porous_wall.for_each(
-            k, [&](Index w) { consider(k, model.walls.x[w], -1, law.rest_distance); });
+            k, [&](Index w) { consider(k, model.walls.x[w], -1, -1, law.rest_distance); });
         s.porous_porous.for_each(k, [&](Index j) {
             const Index b = p.fragment[j];
             if (b == a || p.origin[j] == p.origin[k]) return;
@@ -87,10 +97,10 @@ Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& l
             const Real rest =
                 cracked.empty() ? law.rest_distance
                                 : pair_rest_distance(cracked, p.id[k], p.id[j], law.rest_distance);
-            consider(k, x[j], is_free(b) ? b : -1, rest);
+            consider(k, x[j], is_free(b) ? b : -1, is_free(b) ? -1 : j, rest);
         });
     }
-    if (pairs.empty()) return 0;
+    if (!any_passes) return 0;
     // Projected Gauss-Seidel on the accumulated impulses, serial and in pair order.
     const auto apply = [&](const SpeculativePair& c, Real impulse) {
         const Vec3 j = impulse * c.normal;
@@ -114,13 +124,18 @@ Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& l
             }
     };
     solve();
-    // Then the pairs that took an impulse rebound with the law's restitution, as the springs
-    // give a slow contact: a separation of e times their closing speed before the solve.
+    // Then the impacts that took an impulse rebound with the law's restitution, as the springs
+    // give a slow contact: a separation of e times their closing speed before the solve. A pair
+    // held only against gravity does not bounce.
     if (law.restitution > 0) {
         for (SpeculativePair& c : pairs)
-            if (c.impulse > 0) c.target = law.restitution * c.approach;
+            if (c.impulse > 0 && c.impact) c.target = law.restitution * c.approach;
         solve();
     }
+    // An anchored structure takes the opposite impulse on its member, as the springs' forces
+    // load it (its Biot call's loads).
+    for (const SpeculativePair& c : pairs)
+        if (c.still_member >= 0) still_impulse[c.still_member] -= c.impulse * c.normal;
     // The members move with their fragment's new rigid velocity field.
     parallel_for(p.size(), [&](Index k) {
         const Index f = p.fragment[k];

@@ -19,8 +19,11 @@ inline constexpr Real k_contact_core = 0.75;
 /// Impulses on the free fragments (linear and angular momentum, equal and opposite between two
 /// free fragments) such that no pair closes faster than its gap to the core over dt, gravity
 /// over dt included; the members' velocities follow. A projected Gauss-Seidel solve of the
-/// non-negative impulses; it only slows approaches, so it never adds kinetic energy. Returns
-/// the pairs that took an impulse.
-Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& law, Real dt);
+/// non-negative impulses, which only slow approaches; then the impacts rebound with the law's
+/// restitution, a share e < 1 of their closing speed. The members of anchored structures that
+/// were hit get the opposite impulses added to `still_impulse` (N s, per porous particle).
+/// Returns the pairs that took an impulse.
+Index limit_closing_speeds(const Model& model, State& state, const ContactLaw& law, Real dt,
+                           std::vector<Vec3>& still_impulse);
 
 }  // namespace karst

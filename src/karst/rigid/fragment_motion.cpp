@@ -150,7 +150,8 @@ void advance_fragments(const Model& model, State& state, Real dt) {
         // flew off with energy it never had, so the contacts take sub-steps short enough for
         // the stiffest contact mode, under the step's fixed fluid reactions.
         // Fast approaches first, which the springs would let through the wall's layer.
-        limit_closing_speeds(model, state, law, dt);
+        std::vector<Vec3> still_impulse(p.size(), Vec3::Zero());
+        limit_closing_speeds(model, state, law, dt, still_impulse);
         const Real omega = contact_frequency(model, state, law, dt);
         const int substeps =
             omega > 0 ? std::max(1, int(std::ceil(dt / contact_sub_step(omega, law) - 1e-9))) : 1;
@@ -167,7 +168,9 @@ void advance_fragments(const Model& model, State& state, Real dt) {
             move_fragments(model, state, force, h);
             for (Index k = 0; k < p.size(); ++k) mean[k] += force[k] / substeps;
         }
-        s.force = std::move(mean);  // what the members felt on average: the Biot loads
+        // What the members felt on average, the impacts' impulses included: the Biot loads.
+        for (Index k = 0; k < p.size(); ++k) mean[k] += still_impulse[k] / dt;
+        s.force = std::move(mean);
     }
     if (!state.porous.crack_contacts.empty())
         forget_parted_pairs(state.porous.crack_contacts, p, contact_positions(state), model.dx);

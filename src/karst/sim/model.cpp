@@ -388,8 +388,6 @@ void set_up_porous_materials(Model& m) {
     m.porous_grid = UniformGrid(m.domain, reach);
 }
 
-/// A solid that gets a Biot problem must mesh into tetrahedra: particles on at least two lattice
-/// planes along every axis (one particle, or a one-layer sheet, gives no element).
 /// Whether some cube of the lattice holds four particles of `points` off one plane, so that the
 /// Delaunay mesh of the solid has a tetrahedron no larger than a lattice cell's (its
 /// circumsphere, the cell's, holds no other lattice point). A sheet one particle thick, a line,
@@ -405,8 +403,9 @@ bool holds_a_lattice_cell_tetrahedron(const std::vector<Vec3>& points, Real dx) 
         }
     };
     std::unordered_set<LatticeIndex, Hash> occupied;
-    for (const Vec3& x : points) occupied.insert(index(x));
-    for (const LatticeIndex& p : occupied)
+    for (const Vec3& x : points) {
+        const LatticeIndex p = index(x);
+        occupied.insert(p);
         for (int corner = 0; corner < 8; ++corner) {
             // The cube whose corner `corner` is p; its occupied vertices.
             const LatticeIndex base{p[0] - (corner & 1), p[1] - (corner >> 1 & 1),
@@ -422,10 +421,23 @@ bool holds_a_lattice_cell_tetrahedron(const std::vector<Vec3>& points, Real dx) 
                         if ((in[a] - in[0]).cross(in[b] - in[0]).dot(in[c] - in[0]) != 0)
                             return true;
         }
+    }
     return false;
 }
 
+/// A solid that gets a Biot problem must mesh into tetrahedra: an alpha that keeps a lattice
+/// cell's, and a lattice cell with four of its particles off one plane.
 void check_meshable(const Model& m, const PorousBody& body) {
+    // A lattice cell's tetrahedra have radius^2 3/4 dx^2 (less the weight, 0.3 dx^2, when
+    // weighted; pfem/biot_setup.hpp); M19 keeps a tetrahedron below alpha dx.
+    const PoroelasticSettings& pe = m.scene.poroelastic;
+    const Real cell_radius2 = 0.75 - (pe.weighted_alpha ? 0.3 : 0.0);
+    if (pe.alpha * pe.alpha <= cell_radius2)
+        throw SceneError("/poroelastic/alpha",
+                         fmt::format("an alpha above {:.3g} (the {}radius of a lattice cell's "
+                                     "tetrahedra over dx): below it no tetrahedron is kept",
+                                     std::sqrt(cell_radius2), pe.weighted_alpha ? "ortho" : ""),
+                         fmt::format("{:g}", pe.alpha));
     if (holds_a_lattice_cell_tetrahedron(body.rest_x, m.dx)) return;
     Aabb box;
     for (const Vec3& x : body.rest_x) box.extend(x);
