@@ -93,4 +93,44 @@ void FragmentResponse::member_velocities(const Model& model, const State& state,
     });
 }
 
+FragmentMobility::FragmentMobility(const State& state) {
+    const std::vector<Fragment>& fragments = state.porous.fragments;
+    m_inverse_inertia.assign(fragments.size(), Mat3::Zero());
+    for (size_t q = 0; q < fragments.size(); ++q)
+        if (!fragments[q].anchored && fragments[q].mass > 0)
+            m_inverse_inertia[q] = fragments[q].world_inertia().inverse();
+}
+
+Real FragmentMobility::at(const Model& model, const State& state, Index i) const {
+    const FluidScratch& s = state.scratch;
+    const PorousParticles& porous = state.porous.particles;
+    const std::vector<Fragment>& fragments = state.porous.fragments;
+    const Real rho0_2 = model.rho0 * model.rho0;
+    const Vec3 xi = state.fluid.x[i];
+    const Real* cp = s.porous_coefficient.data() + i * s.fluid_porous.capacity;
+    int k = 0;
+    // The free fragments touched, in list order (a particle touches one or two).
+    Index touched[4];
+    Vec3 push[4], turn[4];
+    int n_touched = 0;
+    s.fluid_porous.for_each(i, [&](Index w) {
+        const Vec3 g = (rho0_2 * cp[k++]) * (xi - porous.x[w]);  // Psi_k grad W_ik
+        const Index q = porous.fragment[w];
+        if (fragments[q].anchored || fragments[q].mass <= 0) return;
+        int slot = 0;
+        while (slot < n_touched && touched[slot] != q) ++slot;
+        if (slot == n_touched) {
+            if (n_touched == 4) return;  // more: the mobility is a little small
+            touched[slot] = q, push[slot] = turn[slot] = Vec3::Zero(), ++n_touched;
+        }
+        push[slot] += 2 * g;
+        turn[slot] += (porous.x[w] - fragments[q].centre).cross(2 * g);
+    });
+    Real mobility = 0;
+    for (int slot = 0; slot < n_touched; ++slot)
+        mobility += push[slot].squaredNorm() / fragments[touched[slot]].mass +
+                    turn[slot].dot(m_inverse_inertia[touched[slot]] * turn[slot]);
+    return mobility;
+}
+
 }  // namespace karst

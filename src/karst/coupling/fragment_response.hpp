@@ -42,4 +42,18 @@ private:
     mutable std::vector<Vec3> m_member_force;  ///< per porous member, N
 };
 
+/// How far the free fragments that fluid particle i touches give way to its pressure, per unit
+/// m_i: a fragment F adds |B_F|^2 / M_F + T_F.I_F^-1 T_F, with B_F = 2 sum_{k in F} Psi_k grad
+/// W_ik and T_F = sum_{k in F} (x_k - c_F) x 2 Psi_k grad W_ik. A pressure solve adds m_i times
+/// it to its diagonal: without it a light fragment took the Jacobi update's over-shoot, and the
+/// solve diverged. Reads the step's pair factors.
+class FragmentMobility {
+public:
+    explicit FragmentMobility(const State& state);
+    Real at(const Model& model, const State& state, Index i) const;
+
+private:
+    std::vector<Mat3> m_inverse_inertia;  ///< per fragment, world frame; zero when anchored
+};
+
 }  // namespace karst

@@ -3,6 +3,7 @@
 // set, the Biot material and boundary conditions, the solver options, the porosity and permeability
 // feedback at the nodes, and the mesh frame arrays.
 #include "karst/io/frame_writer.hpp"
+#include "karst/pfem/alpha_shape_weight.hpp"
 #include "karst/pfem/biot.hpp"
 #include "karst/pfem/nodal_stress.hpp"
 #include "karst/pfem/structure_state.hpp"
@@ -12,12 +13,6 @@
 #include <span>
 
 namespace karst {
-
-/// The weight of the weighted alpha shape (docs/method.md §5.1), m^2: w = (omega_S S + omega_m
-/// m/m_bar) (dx/2)^2 for a saturated, uniform-mass solid (S = 1, m = m_bar).
-inline Real alpha_shape_weight(Real dx) {
-    return (1.0 + 0.2) * 0.25 * dx * dx;
-}
 
 /// §5.1 mesh of the points x (rest positions, spacing dx) with the scene's alpha, delta and
 /// weighted-alpha settings.

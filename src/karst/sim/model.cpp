@@ -1,6 +1,7 @@
 #include "karst/sim/model.hpp"
 
 #include "karst/core/parallel.hpp"
+#include "karst/pfem/alpha_shape_weight.hpp"
 #include "karst/porous/permeability.hpp"
 #include "karst/scene/scene_error.hpp"
 #include "karst/sim/porous_materials.hpp"
@@ -428,10 +429,11 @@ bool holds_a_lattice_cell_tetrahedron(const std::vector<Vec3>& points, Real dx) 
 /// A solid that gets a Biot problem must mesh into tetrahedra: an alpha that keeps a lattice
 /// cell's, and a lattice cell with four of its particles off one plane.
 void check_meshable(const Model& m, const PorousBody& body) {
-    // A lattice cell's tetrahedra have radius^2 3/4 dx^2 (less the weight, 0.3 dx^2, when
-    // weighted; pfem/biot_setup.hpp); M19 keeps a tetrahedron below alpha dx.
+    // A lattice cell's tetrahedra have radius^2 3/4 dx^2 (less the weight when weighted);
+    // M19 keeps a tetrahedron below alpha dx.
     const PoroelasticSettings& pe = m.scene.poroelastic;
-    const Real cell_radius2 = 0.75 - (pe.weighted_alpha ? 0.3 : 0.0);
+    const Real cell_radius2 =
+        0.75 - (pe.weighted_alpha ? alpha_shape_weight(m.dx) / (m.dx * m.dx) : 0.0);
     if (pe.alpha * pe.alpha <= cell_radius2)
         throw SceneError("/poroelastic/alpha",
                          fmt::format("an alpha above {:.3g} (the {}radius of a lattice cell's "

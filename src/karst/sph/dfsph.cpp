@@ -11,56 +11,24 @@ namespace karst {
 
 namespace {
 
-/// -d rho*_i / d p_i = dt^2 / rho0^2 (|G_i|^2 + m_i sum_j m_j |grad W_ij|^2 + fragments), with
-/// G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik, the gradient of both the predicted density
-/// (density_change) and the pressure force. A free fragment F that p_i pushes away adds
-/// m_i (|B_F|^2 / M_F + T_F.I_F^-1 T_F), B_F = 2 sum_{k in F} Psi_k grad W_ik and T_F = sum_{k in
-/// F} (x_k - c_F) x 2 Psi_k grad W_ik: without it a light fragment took the Jacobi update's
-/// over-shoot, and the solve diverged. Fixed for the step.
+/// -d rho*_i / d p_i = dt^2 / rho0^2 (|G_i|^2 + m_i sum_j m_j |grad W_ij|^2 + m_i mobility_i),
+/// with G_i = sum_j m_j grad W_ij + 2 sum_k Psi_k grad W_ik, the gradient of both the predicted
+/// density (density_change) and the pressure force, and the free fragments' mobility
+/// (coupling/fragment_response.hpp). Fixed for the step.
 void compute_diagonal(const Model& model, State& state, Real dt) {
     const FluidParticles& f = state.fluid;
     FluidScratch& s = state.scratch;
     const Real rho0_2 = model.rho0 * model.rho0, scale = dt * dt / rho0_2;
-    const int cap_p = s.fluid_porous.capacity;
-    const PorousParticles& porous = state.porous.particles;
-    const std::vector<Fragment>& fragments = state.porous.fragments;
-    std::vector<Mat3> inverse_inertia(fragments.size(), Mat3::Zero());
-    for (size_t q = 0; q < fragments.size(); ++q)
-        if (!fragments[q].anchored && fragments[q].mass > 0)
-            inverse_inertia[q] = fragments[q].world_inertia().inverse();
+    const FragmentMobility mobility(state);
     s.diagonal.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
-        const Vec3 xi = f.x[i];
         const FluidGradientSums fluid = fluid_gradient_sums(model, state, i);
         const Vec3 boundary = rho0_2 * s.boundary_sums.gradient[i];  // sum_k Psi_k grad W_ik
-        const Real* cp = s.porous_coefficient.data() + i * cap_p;
-        int k = 0;
-        // The free fragments touched, in list order (a particle touches one or two).
-        Index touched[4];
-        Vec3 push[4], turn[4];
-        int n_touched = 0;
-        s.fluid_porous.for_each(i, [&](Index w) {
-            const Vec3 g = (rho0_2 * cp[k++]) * (xi - porous.x[w]);  // Psi_k grad W_ik
-            const Index q = porous.fragment[w];
-            if (fragments[q].anchored || fragments[q].mass <= 0) return;
-            int slot = 0;
-            while (slot < n_touched && touched[slot] != q) ++slot;
-            if (slot == n_touched) {
-                if (n_touched == 4) return;  // more: the diagonal is a little small
-                touched[slot] = q, push[slot] = turn[slot] = Vec3::Zero(), ++n_touched;
-            }
-            push[slot] += 2 * g;
-            turn[slot] += (porous.x[w] - fragments[q].centre).cross(2 * g);
-        });
-        Real mobility = 0;  // the fragments' share, per unit m_i
-        for (int slot = 0; slot < n_touched; ++slot)
-            mobility += push[slot].squaredNorm() / fragments[touched[slot]].mass +
-                        turn[slot].dot(inverse_inertia[touched[slot]] * turn[slot]);
         // sum_j m_i m_j |grad W_ij|^2, read as (m_i / m_0) sum_j |m_j grad W_ij|^2 (equal for
         // water).
         const Real own = (fluid.sum + 2 * boundary).squaredNorm();
         s.diagonal[i] = scale * (own + fluid.squares * f.sph_mass[i] / model.particle_mass +
-                                 f.sph_mass[i] * mobility);
+                                 f.sph_mass[i] * mobility.at(model, state, i));
     });
 }
 

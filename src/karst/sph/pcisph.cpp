@@ -2,6 +2,7 @@
 
 #include "karst/core/parallel.hpp"
 #include "karst/coupling/boundary_pair.hpp"
+#include "karst/coupling/fragment_response.hpp"
 #include "karst/sph/density.hpp"
 #include "karst/sph/integrate.hpp"
 #include "karst/sph/pressure_acceleration.hpp"
@@ -42,6 +43,8 @@ void pressure_acceleration_and_prediction(const Model& model, State& state, Real
 /// sum, the prototype delta over-relaxes there, and with the maximum-error stopping rule the loop
 /// diverges. Capping keeps the prototype everywhere it is stable (the interior, free surface).
 /// Then under-relaxed by k_pressure_relaxation [D] (sph/pressure_acceleration.hpp says why).
+/// The free fragments that give way to p_i add m_i times their mobility to the denominator, as
+/// in DFSPH's diagonal (coupling/fragment_response.hpp).
 /// Reads the step's pair factors (update_density_and_pair_coefficients).
 void compute_delta(const Model& model, const State& state, Real dt, std::vector<Real>& delta) {
     const FluidParticles& f = state.fluid;
@@ -49,21 +52,24 @@ void compute_delta(const Model& model, const State& state, Real dt, std::vector<
     const Real rho0_2 = model.rho0 * model.rho0;
     const Real prototype = model.pcisph_delta(dt);
     const Real scale = rho0_2 / (2 * dt * dt);
+    const FragmentMobility mobility(state);
     delta.resize(f.size());
     parallel_for(f.size(), [&](Index i) {
         // The boundary's sum_k Psi_k grad W_ik = rho0^2 sum_k c_ik x_ik is summed once a step.
         const FluidGradientSums fluid = fluid_gradient_sums(model, state, i);
         const Real denominator =
-            (fluid.sum + 2 * rho0_2 * s.boundary_sums.gradient[i]).squaredNorm() + fluid.squares;
+            (fluid.sum + 2 * rho0_2 * s.boundary_sums.gradient[i]).squaredNorm() + fluid.squares +
+            f.sph_mass[i] * mobility.at(model, state, i);
         delta[i] = k_pressure_relaxation *
                    (denominator > 0 ? std::min(prototype, scale / denominator) : prototype);
     });
 }
 
 /// sum_k Psi_k W(|x - x_k|) over fluid particle i's wall and porous neighbours (the step's
-/// lists): the boundary's part of M7's density at x, kg/m^3. Walls and porous particles stay put
-/// during the solve.
-Real boundary_density(const Model& model, const State& state, Index i, const Vec3& x) {
+/// lists): the boundary's part of M7's density at x, kg/m^3. Walls stay put during the solve;
+/// porous members move on by dt v_porous[k] when given (free fragments in the solve).
+Real boundary_density(const Model& model, const State& state, Index i, const Vec3& x, Real dt = 0,
+                      const std::vector<Vec3>* v_porous = nullptr) {
     const FluidScratch& s = state.scratch;
     const CubicKernel& W = model.kernel;
     const PorousParticles& porous = state.porous.particles;
@@ -71,7 +77,10 @@ Real boundary_density(const Model& model, const State& state, Index i, const Vec
     Real rho = 0;
     s.fluid_wall.for_each(
         i, [&](Index k) { rho += model.walls.psi[k] * W.w((x - model.walls.x[k]).norm()); });
-    s.fluid_porous.for_each(i, [&](Index k) { rho += psi[k] * W.w((x - porous.x[k]).norm()); });
+    s.fluid_porous.for_each(i, [&](Index k) {
+        const Vec3 xk = v_porous ? Vec3(porous.x[k] + dt * (*v_porous)[k]) : porous.x[k];
+        rho += psi[k] * W.w((x - xk).norm());
+    });
     return rho;
 }
 
@@ -98,6 +107,22 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
     parallel_for(n,
                  [&](Index i) { s.rho_boundary[i] = boundary_density(model, state, i, f.x[i]); });
     parallel_for(n, [&](Index i) { s.x_pred[i] = f.x[i] + dt * (f.v[i] + dt * s.a_other[i]); });
+    // Free fragments in the solve (coupling/fragment_response.hpp): their members move on with
+    // gravity and the reaction of the current pressures, so the fluid under a landing fragment
+    // is not squeezed as if the fragment were infinitely heavy.
+    // Anchored members stay put, as without free fragments.
+    const FragmentResponse fragments(model, state, dt, true, nullptr);
+    const std::vector<Vec3>* moving = fragments.active() ? &s.porous_v_pred : nullptr;
+    const auto predict_members = [&] {
+        fragments.member_velocities(model, state, f.p, BoundaryPressure::Hydrostatic,
+                                    s.porous_v_pred);
+        const PorousParticles& porous = state.porous.particles;
+        parallel_for(porous.size(), [&](Index k) {
+            if (state.porous.fragments[porous.fragment[k]].anchored)
+                s.porous_v_pred[k] = Vec3::Zero();
+        });
+    };
+    if (moving) predict_members();
 
     // The tolerance and the density target as rates: a step of the share `rate` of the sound's
     // crossing time removes that share of a compression, within that share of the band
@@ -116,7 +141,7 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
             Real rho = f.sph_mass[i] * W.w0();
             s.fluid_fluid.for_each(
                 i, [&](Index j) { rho += f.sph_mass[j] * W.w((xi - s.x_pred[j]).norm()); });
-            rho += 2 * boundary_density(model, state, i, xi) - s.rho_boundary[i];
+            rho += 2 * boundary_density(model, state, i, xi, dt, moving) - s.rho_boundary[i];
             // Signed error from the target, p clamped at 0 (docs/method.md §4.3); the stopping
             // test reads the compression, or the over-pressure p_i could give back where the
             // fluid expands.
@@ -127,6 +152,7 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
         report.max_density_error =
             parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / (rate * rho0);
         pressure_acceleration_and_prediction(model, state, dt);
+        if (moving) predict_members();
         ++report.iterations;
         // Stopping rule (docs/method.md §4.3; the paper's l.13 never ends).
         if (report.iterations >= fs.min_iterations &&
