@@ -106,5 +106,28 @@ TEST(Determinism, ACoupledRunWithBiotCallsAndARemeshIsIdenticalOnOneAndTwoThread
     EXPECT_TRUE(same_bits(s.mesh.tets, r.mesh.tets));
 }
 
+// A free stone sphere entering water, with each pressure solve: the fragments' reactions inside
+// the solves (coupling/fragment_response.hpp) are summed in member order.
+TEST(Determinism, AFragmentFallingIntoWaterIsIdenticalOnOneAndTwoThreads) {
+    for (const char* solver : {"dfsph", "pcisph"}) {
+        SCOPED_TRACE(solver);
+        const std::string scene = R"({ "name": "stone", "particle_spacing": 0.02,
+      "fluid": { "solver": ")" + std::string(solver) +
+                                  R"(" },
+      "fluid_blocks": [ { "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.2] } } ],
+      "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.5] } } ],
+      "porous_solids": [ { "anchored": false, "shape": { "type": "sphere", "center": [0.2, 0.2, 0.28], "radius": 0.07 },
+                           "material": { "porosity": 0, "solid_density": 2600 } } ] })";
+        const Outcome a = run(scene, 1, 60), b = run(scene, 2, 60);
+        EXPECT_GE(b.threads_seen, 2u) << "the parallel runtime used one thread";
+        ASSERT_EQ(a.state.steps, b.state.steps);
+        EXPECT_LT(a.state.porous.fragments[0].centre[2], 0.26) << "m: the sphere enters the water";
+        EXPECT_TRUE(same_bits(a.state.fluid.x, b.state.fluid.x));
+        EXPECT_TRUE(same_bits(a.state.fluid.p, b.state.fluid.p));
+        EXPECT_TRUE(same_bits(a.state.porous.particles.x, b.state.porous.particles.x));
+        EXPECT_TRUE(same_bits(a.state.porous.particles.v, b.state.porous.particles.v));
+    }
+}
+
 }  // namespace
 }  // namespace karst

@@ -14,8 +14,8 @@ namespace karst {
 class FragmentResponse {
 public:
     /// The free fragments' velocities before this solve's pressure: their present ones, plus
-    /// dt g when the solve includes the step's other forces (DFSPH's density solve), plus dt
-    /// times the reaction of `earlier` (the divergence pressure, read mirrored) when given.
+    /// dt g when the solve includes the step's other forces (DFSPH's density solve, PCISPH), plus
+    /// dt times the reaction of `earlier` (the divergence pressure, read mirrored) when given.
     FragmentResponse(const Model& model, const State& state, Real dt, bool with_gravity,
                      const std::vector<Real>* earlier);
 

@@ -152,12 +152,12 @@ PressureSolveReport solve_pressure_pcisph(const Model& model, State& state, Real
         report.max_density_error =
             parallel_max(n, 0.0, [&](Index i) { return s.rho_err[i]; }) / (rate * rho0);
         pressure_acceleration_and_prediction(model, state, dt);
-        if (moving) predict_members();
         ++report.iterations;
         // Stopping rule (docs/method.md §4.3; the paper's l.13 never ends).
         if (report.iterations >= fs.min_iterations &&
             report.max_density_error <= fs.max_density_error)
             break;
+        if (moving) predict_members();
     }
     return report;
 }
