@@ -118,7 +118,7 @@ TEST(Determinism, AFragmentFallingIntoWaterIsIdenticalOnOneAndTwoThreads) {
       "walls": [ { "kind": "container", "shape": { "type": "box", "min": [0, 0, 0], "max": [0.4, 0.4, 0.5] } } ],
       "porous_solids": [ { "anchored": false, "shape": { "type": "sphere", "center": [0.2, 0.2, 0.28], "radius": 0.07 },
                            "material": { "porosity": 0, "solid_density": 2600 } } ] })";
-        const Outcome a = run(scene, 1, 60), b = run(scene, 2, 60);
+        const Outcome a = run(scene, 1, 30), b = run(scene, 2, 30);
         EXPECT_GE(b.threads_seen, 2u) << "the parallel runtime used one thread";
         ASSERT_EQ(a.state.steps, b.state.steps);
         EXPECT_LT(a.state.porous.fragments[0].centre[2], 0.26) << "m: the sphere enters the water";
