@@ -469,8 +469,17 @@ TEST(FractureScene, ABarUnderARampedCompressionSlipsAtItsCompressiveStrengthOnTh
     ASSERT_GT(t, 0) << "no crack under twice the compressive strength";
     EXPECT_GE(t, 0.95);
     EXPECT_LE(t, 1.05);
-    for (const CrackRecord& c : sim.state.structures.cracks)  // 60 degrees off the load axis
+    // 60 degrees off the load axis: the cracks of the uniaxial stress, the call's first round.
+    // The rounds repeated after them solve a bar cut by shear cracks that nothing presses shut
+    // (the Biot problem has no contact across a crack), a near-mechanism whose stress no
+    // criterion is tested against here.
+    int first_round = 0;
+    for (const CrackRecord& c : sim.state.structures.cracks) {
+        if (c.round > 0) continue;
+        ++first_round;
         EXPECT_NEAR(std::abs(c.normal[0]), 0.5, std::sin(5 * std::numbers::pi / 180));
+    }
+    EXPECT_GE(first_round, 2);
     test::Simulation rankine(free_bar(ramp, "", 1e8));
     EXPECT_LT(first_crack_time(rankine, 2), 0) << "Rankine cracked a bar in compression";
 }

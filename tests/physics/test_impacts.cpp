@@ -230,5 +230,17 @@ TEST(EnergyAccount, AGainWithNothingReleasedIsReported) {
     EXPECT_TRUE(b.gained_more_than(0.05));
 }
 
+// A solid at rest whose potential energy moves by round-off both ways (568 J, 1e-15 of it): what
+// it "releases" is round-off too, and the gain that follows is no share of it.
+TEST(EnergyAccount, RoundOffAfterARoundOffReleaseIsNoGain) {
+    EnergyAccount a({0, 568.673438});
+    a.add({0, 568.673438 - 6.8e-13});
+    a.add({0, 568.673438 - 3.4e-13});
+    EXPECT_GT(a.released(), 0);
+    EXPECT_FALSE(a.gained_more_than(0.05));
+    a.add({0, 568.673438 + 1e-5});  // a real gain, above the sum's round-off
+    EXPECT_TRUE(a.gained_more_than(0.05));
+}
+
 }  // namespace
 }  // namespace karst

@@ -186,7 +186,7 @@ CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
     constexpr int k_sides = 16;
     CrackFrame frame;
     std::vector<Vec3> normal;
-    std::vector<Real> radius, area, time;
+    std::vector<Real> radius, area, time, round;
     for (const CrackRecord& c : cracks) {
         // Two unit vectors spanning the crack plane.
         const Vec3 a = c.normal.unitOrthogonal(), b = c.normal.cross(a);
@@ -197,7 +197,7 @@ CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
             frame.vertices.x.push_back(c.centre +
                                        c.radius * (std::cos(angle) * a + std::sin(angle) * b));
             normal.push_back(c.normal), radius.push_back(c.radius), area.push_back(c.area),
-                time.push_back(c.time);
+                time.push_back(c.time), round.push_back(c.round);
         }
         frame.polygons.push_back(std::move(polygon));
     }
@@ -205,6 +205,7 @@ CrackFrame crack_frame(const std::vector<CrackRecord>& cracks) {
     frame.vertices.add_scalar("radius", radius);
     frame.vertices.add_scalar("area", area);
     frame.vertices.add_scalar("time", time);
+    frame.vertices.add_scalar("round", round);
     return frame;
 }
 

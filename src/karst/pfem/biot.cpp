@@ -23,7 +23,6 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o, const Bio
     elements.resize(mesh.tet_count());
     for (Index e = 0; e < mesh.tet_count(); ++e) elements[e] = p1_tet(mesh, e);
     split_dofs();
-    balance = LoadBalance(mesh.nodes, problem, u_dofs);
     if (options.polyhedral) {
         Real spacing = 0;  // gradient step 1e-4 of the mean edge length (M21: 1e-4 dx)
         for (const Tet& t : mesh.tets) spacing += (mesh.nodes[t[1]] - mesh.nodes[t[0]]).norm();
@@ -38,6 +37,11 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o, const Bio
     f_body = f_ext;
     f_extra = Vector::Zero(3 * n), f_rest = Vector::Zero(3 * n);
     apply_boundary_values(problem.nodal_force, problem.prescribed_u, problem.drained_pressure);
+    KARST_CHECK(problem.node_mass.empty() || problem.node_mass.size() == size_t(n));
+    balance = LoadBalance(mesh.nodes, problem, u_dofs,
+                          problem.node_mass.empty()
+                              ? lumped_volume
+                              : Vector(Eigen::Map<const Vector>(problem.node_mass.data(), n)));
     mass_ff = p_dofs.split(mass).first;
     assemble_flow();
     t_assembly = watch.seconds();
@@ -104,8 +108,13 @@ void BiotSolver::Impl::tie_platens() {
 }
 
 Vector BiotSolver::Impl::solve_elastic(const Vector& rhs, const Vector& guess) {
-    if (tie.cols() == 0) return elastic.solve(rhs, guess);
-    return tie * elastic.solve(tie.transpose() * rhs, Vector::Zero(tie.cols()));  // direct
+    // [D] A platen's nodes share one displacement, which a fitted turn would part: there the
+    // rigid part is left as the spring leaves it (a platen holds its body in practice).
+    if (tie.cols() > 0)
+        return tie * elastic.solve(tie.transpose() * rhs, Vector::Zero(tie.cols()));  // direct
+    Vector u = elastic.solve(rhs, guess);
+    balance.remove_rigid_motion(u);
+    return u;
 }
 
 AmgOptions BiotSolver::Impl::elastic_amg_options() const {
@@ -187,7 +196,8 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
                 flow.solve(p_dofs.gather_free(rhs_full) - dt * (H_fc * p_c), p_dofs.gather_free(p)),
                 p_next);
         // The fixed-point residual G(p^k) - p^k, before any mixing, is what the test below reads.
-        report.p_change.push_back(relative_change(p_next - p_n, p - p_n));
+        report.p_change.push_back(
+            relative_change(p_next - p_n, p - p_n, options.tolerance * p_next.norm()));
         if (accelerate) p_next = anderson.next(p, p_next);
         // 2. Mechanics with p frozen: K u = f_ext + Q p.
         Vector rhs_u = u_dofs.gather_free(f_ext + Q * p_next) - elastic_lift;
@@ -199,8 +209,12 @@ BiotCallReport BiotSolver::Impl::advance(Real dt, BiotFields& fields) {
         ++report.elastic_solves;
         // 3. Changes relative to the change over the call [D]: M22 divides by |p^{k+1}|, but
         // when a slow consolidation adds a small increment per call that test passes after
-        // one iteration, and the unconverged increments add up (Terzaghi lagged 10 %).
-        report.u_change.push_back(relative_change(u_next - u_n, u - u_n));
+        // one iteration, and the unconverged increments add up (Terzaghi lagged 10 %). The
+        // change over the call counts as at least tolerance times the field (p above too): a
+        // body near its steady state changes by 1e-7 of its u in a call, and the iterations'
+        // changes, a thousandth of that, never passed the test, though they are 1e-10 of u.
+        report.u_change.push_back(
+            relative_change(u_next - u_n, u - u_n, options.tolerance * u_next.norm()));
         p = std::move(p_next), u = std::move(u_next);
         ++report.iterations;
         if (report.p_change.back() < options.tolerance &&

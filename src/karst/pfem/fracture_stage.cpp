@@ -50,7 +50,7 @@ std::vector<Vec3> layer_normals(const std::vector<Mat3>& tensors, Real ratio) {
 }
 
 /// Cracks structure `slot`; returns true when its mesh changed.
-bool fracture_structure(const Model& model, State& state, size_t slot, Real time) {
+bool fracture_structure(const Model& model, State& state, size_t slot, Real time, int round) {
     StructureState& st = state.structures;
     PorousParticles& p = state.porous.particles;
     Structure& s = st.structures[slot];
@@ -128,8 +128,8 @@ bool fracture_structure(const Model& model, State& state, size_t slot, Real time
     for (size_t m = 0; m < cracks.size(); ++m) {
         const Crack& c = cracks[m];
         if (links_broken[m] == 0) continue;
-        st.cracks.push_back(
-            {c.centre + s.fields.u[c.node], c.normal, c.radius, c.area, time, links_broken[m]});
+        st.cracks.push_back({c.centre + s.fields.u[c.node], c.normal, c.radius, c.area, time,
+                             links_broken[m], round});
         ++st.fracture.cracks;
     }
     st.fracture.links_broken += broken;
@@ -317,12 +317,12 @@ std::vector<Real> strength_scale(const Model& model, const State& state, const S
     return scale;
 }
 
-bool fracture_structures(const Model& model, State& state, Real time) {
+bool fracture_structures(const Model& model, State& state, Real time, int round) {
     if (!model.scene.fracture.enabled) return false;
     bool changed = false;
     const size_t count = state.structures.structures.size();
     for (size_t slot = 0; slot < count; ++slot)
-        changed = fracture_structure(model, state, slot, time) || changed;
+        changed = fracture_structure(model, state, slot, time, round) || changed;
     if (changed) refresh_fragment_mass(state, model.dx);
     return changed;
 }

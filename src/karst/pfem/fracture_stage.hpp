@@ -11,9 +11,10 @@
 
 namespace karst {
 
-/// Cracks made at `time` are recorded with it. Returns true when some structure changed (new
-/// particles or fragments): the pore-flow pairs are then stale.
-bool fracture_structures(const Model& model, State& state, Real time);
+/// Cracks made at `time` are recorded with it and their call's fracture `round` (CrackRecord).
+/// Returns true when some structure changed (new particles or fragments): the pore-flow pairs
+/// are then stale.
+bool fracture_structures(const Model& model, State& state, Real time, int round = 0);
 
 /// Per node of structure `s`, the factor on its material's strengths from its saturation (the
 /// wet strength at S = 1); empty when the material has no wet strength. `index_of` maps a

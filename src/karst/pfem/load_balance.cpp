@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 
 #include <numeric>
+#include <tuple>
 
 namespace karst {
 
@@ -21,10 +22,31 @@ struct PieceModes {
     std::vector<std::pair<int, Eigen::VectorXd>> values;
 };
 
+/// The free rigid motions R of a group's nodes on its rows (`local`: free row -> group row, of
+/// `w.size()`) and their fit (R^T W R)^-1 R^T W, W = diag(w).
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> rigid_fit(
+    const std::vector<Vec3>& nodes, const std::vector<std::uint8_t>& fixed, const DofSplit& dofs,
+    const std::vector<Index>& group, const std::vector<int>& local, const Eigen::VectorXd& w) {
+    std::vector<Vec3> x;
+    std::vector<std::uint8_t> held;
+    for (Index a : group) x.push_back(nodes[a]), held.push_back(fixed[a]);
+    const Eigen::Matrix<Real, 6, Eigen::Dynamic> free = free_rigid_modes(x, held);
+    if (free.cols() == 0) return {};
+    const RigidFrame frame(x);
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(w.size(), free.cols());
+    for (size_t i = 0; i < group.size(); ++i)
+        for (int d = 0; d < 3; ++d)
+            if (const int row = dofs.free_index[3 * group[i] + d]; row >= 0 && local[row] >= 0)
+                R.row(local[row]) = frame.row(x[i], d) * free;
+    const Eigen::MatrixXd RtW = R.transpose() * w.asDiagonal();
+    Eigen::MatrixXd fit = (RtW * R).completeOrthogonalDecomposition().solve(RtW);
+    return {std::move(R), std::move(fit)};
+}
+
 }  // namespace
 
 LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& problem,
-                         const DofSplit& dofs) {
+                         const DofSplit& dofs, const Vector& node_mass) {
     const Index n = Index(nodes.size());
     std::vector<std::vector<Index>> whole;
     if (problem.free_body && problem.unheld_pieces.empty()) {
@@ -80,10 +102,22 @@ LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& prob
                     {columns[g]++, 1, {{add_row(g, row), Eigen::VectorXd::Ones(1)}}});
             }
 
+    // Each group's nodes, once each (a hinge node is in several of its pieces).
+    std::vector<std::vector<Index>> group_nodes(pieces.size());
+    for (Index a = 0; a < n; ++a)
+        if (pieces_at[a] > 0) group_nodes[root(owner[a])].push_back(a);
+
     for (size_t g = 0; g < pieces.size(); ++g) {
         if (rows[g].empty()) continue;
         Group out;
         const Eigen::Index m = Eigen::Index(rows[g].size());
+        Eigen::VectorXd w = Eigen::VectorXd::Zero(m);  // the rows' node masses
+        for (Index a : group_nodes[g])
+            for (int d = 0; d < 3; ++d)
+                if (const int row = dofs.free_index[3 * a + d]; row >= 0 && local[row] >= 0)
+                    w[local[row]] = node_mass[a];
+        std::tie(out.rigid, out.fit) =
+            rigid_fit(nodes, problem.fixed, dofs, group_nodes[g], local, w);
         out.rows = std::move(rows[g]);
         if (double(m) * double(columns[g]) > k_max_basis_entries) {
             out.all_rows = true;
@@ -94,6 +128,8 @@ LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& prob
                     R.block(at, piece.first_column, 1, piece.count) = v.transpose();
             const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(R);
             out.basis = qr.householderQ() * Eigen::MatrixXd::Identity(m, qr.rank());
+            const Eigen::MatrixXd WQ = w.asDiagonal() * out.basis;
+            out.relief = WQ * (out.basis.transpose() * WQ).inverse();
         }
         m_groups.push_back(std::move(out));
     }
@@ -107,8 +143,18 @@ void LoadBalance::apply(Vector& rhs) const {
         }
         Eigen::VectorXd v(g.rows.size());
         for (size_t i = 0; i < g.rows.size(); ++i) v[Eigen::Index(i)] = rhs[g.rows[i]];
-        v -= g.basis * (g.basis.transpose() * v);
+        v -= g.relief * (g.basis.transpose() * v);
         for (size_t i = 0; i < g.rows.size(); ++i) rhs[g.rows[i]] = v[Eigen::Index(i)];
+    }
+}
+
+void LoadBalance::remove_rigid_motion(Vector& u) const {
+    for (const Group& g : m_groups) {
+        if (g.rigid.cols() == 0) continue;
+        Eigen::VectorXd v(g.rows.size());
+        for (size_t i = 0; i < g.rows.size(); ++i) v[Eigen::Index(i)] = u[g.rows[i]];
+        v -= g.rigid * (g.fit * v);
+        for (size_t i = 0; i < g.rows.size(); ++i) u[g.rows[i]] = v[Eigen::Index(i)];
     }
 }
 

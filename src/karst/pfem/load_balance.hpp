@@ -2,9 +2,14 @@
 // Loads of unanchored pieces balanced against their rigid motions (docs/method.md §5.3). A piece
 // of an anchored fragment that no fixed node holds (an island left by dissolution, a ledge
 // anchored in the air) has a singular elasticity; eps diag(K) makes it invertible, but a net load
-// f then moves it rigidly by about |f| / (eps K), kilometres. Removing from the mechanics' right
-// side its part along the piece's free rigid modes lets the anchor that holds the fragment take
-// the net force and moment, and leaves the deformation.
+// f then moves it rigidly by about |f| / (eps K), kilometres. Its loads are balanced by the
+// inertia of a rigid acceleration (inertia relief: a load f_a at node a less m_a (a + alpha x r_a),
+// with a and alpha such that the net force and moment vanish), so the anchor that holds the
+// fragment takes the net force and moment and the piece deforms under the rest; its own weight
+// then strains nothing. The solution's rigid part, which the weak spring leaves weighted by
+// diag(K), is removed weighted by the nodes' masses: the deformation moves neither the piece's
+// centre of mass nor its mean turn (a free block rose by microns per call otherwise, potential
+// energy that the run's account reported as gained).
 #include "karst/pfem/biot.hpp"
 #include "karst/pfem/sparse_linear.hpp"
 
@@ -17,18 +22,27 @@ public:
     LoadBalance() = default;
     /// The free rigid modes of `problem.unheld_pieces` (of the whole mesh for a free body without
     /// pieces), on the free displacement rows of `dofs`. Pieces that share a node (a hinge) are
-    /// balanced together.
-    LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& problem, const DofSplit& dofs);
-    /// Removes from `rhs` (free displacement rows) its part along the modes.
+    /// balanced together. `node_mass` weighs the nodes (lumped volumes, or the particles' masses).
+    LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& problem, const DofSplit& dofs,
+                const Vector& node_mass);
+    /// Balances `rhs` (free displacement rows) by the modes' inertia: afterwards Q^T rhs = 0.
     void apply(Vector& rhs) const;
+    /// Removes from `u` (free displacement rows) each group's rigid motion, its volume-weighted
+    /// least-squares fit weighted by the node masses: the group's centre of mass and mean turn stay
+    /// where they were.
+    void remove_rigid_motion(Vector& u) const;
 
 private:
-    /// A group of pieces joined by shared nodes: its free rows and an orthonormal basis of its
-    /// modes on them; without a basis (a group too big for a dense one) its loads are removed.
+    /// A group of pieces joined by shared nodes: its free rows, an orthonormal basis Q of its
+    /// modes on them (each piece's, and a hinge node's rows alone) and the inertia relief
+    /// W Q (Q^T W Q)^-1, W the rows' node masses; without a basis (a group too big for a dense
+    /// one) its loads are removed. `rigid` holds the group's rigid motions R as one body, `fit`
+    /// = (R^T W R)^-1 R^T W.
     struct Group {
         std::vector<int> rows;
-        Eigen::MatrixXd basis;
+        Eigen::MatrixXd basis, relief;
         bool all_rows = false;
+        Eigen::MatrixXd rigid, fit;
     };
     std::vector<Group> m_groups;
 };

@@ -6,6 +6,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -81,9 +82,9 @@ struct DofSplit {
     }
 };
 
-/// |next - previous| / |next| (or the absolute change when next is zero).
-inline Real relative_change(const Vector& next, const Vector& previous) {
-    const Real norm = next.norm();
+/// |next - previous| / max(|next|, floor) (or the absolute change when both are zero).
+inline Real relative_change(const Vector& next, const Vector& previous, Real floor = 0) {
+    const Real norm = std::max(next.norm(), floor);
     const Real change = (next - previous).norm();
     return norm > 0 ? change / norm : change;
 }

@@ -64,6 +64,9 @@ struct CrackRecord {
     Real radius = 0, area = 0;                           ///< m, m^2 (M26, before the clamp)
     Real time = 0;                                       ///< s
     Index links_broken = 0;
+    /// The fracture round of its Biot call: 0 for the cracks of the call's own stress, k for
+    /// the k-th solve repeated at once after cracks (sim/step.cpp).
+    int round = 0;
 };
 
 /// What fracture did so far (stats.json "fracture"; its time is the step profile's "fracture").

@@ -82,7 +82,7 @@ void fields(Ar& ar, PfemTimings& t) {
 
 template <class Ar>
 void fields(Ar& ar, CrackRecord& c) {
-    ar(c.centre, c.normal, c.radius, c.area, c.time, c.links_broken);
+    ar(c.centre, c.normal, c.radius, c.area, c.time, c.links_broken, c.round);
 }
 
 template <class Ar>

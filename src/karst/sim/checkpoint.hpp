@@ -15,7 +15,7 @@
 namespace karst {
 
 /// Bumped whenever the layout changes: a checkpoint of another layout is refused.
-inline constexpr std::uint32_t k_checkpoint_format = 8;
+inline constexpr std::uint32_t k_checkpoint_format = 9;
 
 /// What a checkpoint must match to be resumed.
 struct CheckpointKey {

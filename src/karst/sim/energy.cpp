@@ -51,12 +51,14 @@ void EnergyAccount::add(const Energy& e) {
     // With nothing released yet, a gain above round-off (and above 1 mJ, since the potential's
     // origin is arbitrary and energies that the account leaves out, such as surface tension's,
     // may move a little) is more than any share of it.
-    const Real round_off = 1e-6 * (std::abs(m_start.kinetic) + std::abs(m_start.potential) +
-                                   std::abs(m_start.contact)) +
-                           1e-3;
-    if (m_released > 0)
+    // A gain within the sum's round-off is no gain, whatever was released (a solid at rest
+    // whose deformation keeps its centre of mass moves it by 1e-15 of its potential energy).
+    const Real magnitude =
+        std::abs(m_start.kinetic) + std::abs(m_start.potential) + std::abs(m_start.contact);
+    const Real round_off = 1e-6 * magnitude + 1e-3;
+    if (m_released > 0 && gain > 1e-9 * magnitude)
         m_worst_ratio = std::max(m_worst_ratio, gain / m_released);
-    else if (gain > round_off)
+    else if (m_released <= 0 && gain > round_off)
         m_worst_ratio = std::numeric_limits<Real>::infinity();
     m_lowest = std::min(m_lowest, e.total());
 }

@@ -269,7 +269,7 @@ StepReport step(const Model& model, State& state, Real dt_wanted, StepProfile& p
                 if (round >= k_fracture_rounds && largest_call_displacement(state) <= model.dx)
                     break;
                 if (!timed(profile, t, Stage::Fracture,
-                           [&] { return fracture_structures(model, state, t + dt); }))
+                           [&] { return fracture_structures(model, state, t + dt, round); }))
                     break;
                 state.porous_scratch.pairs_stale = true;
                 timed(profile, t, Stage::Structure,
