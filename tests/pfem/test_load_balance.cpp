@@ -6,6 +6,7 @@
 #include "karst/pfem/biot.hpp"
 #include "karst/pfem/biot_setup.hpp"
 #include "karst/pfem/box_nodes.hpp"
+#include "karst/pfem/load_balance.hpp"
 
 #include <gtest/gtest.h>
 
@@ -36,35 +37,19 @@ std::vector<Vec3> solve(const TetMesh& mesh, const BiotProblem& problem) {
     return fields.u;
 }
 
-/// The nodes' lumped volumes: a quarter of each tet's at each of its nodes.
-std::vector<Real> node_volumes(const TetMesh& mesh) {
-    std::vector<Real> volume(mesh.node_count(), 0);
-    for (const Tet& t : mesh.tets) {
-        const Vec3& x0 = mesh.nodes[t[0]];
-        const Real v =
-            std::abs(
-                (mesh.nodes[t[1]] - x0).dot((mesh.nodes[t[2]] - x0).cross(mesh.nodes[t[3]] - x0))) /
-            6;
-        for (Index a : t) volume[a] += v / 4;
-    }
-    return volume;
-}
-
-/// Volume-weighted mean displacement and mean turn sum V (x - c) x u / sum V |x - c|^2 of the
-/// nodes `of`.
+/// Mean displacement and mean turn sum (x - c) x u / sum |x - c|^2 of the nodes `of`, every node
+/// alike (the particles of a structure weigh alike).
 std::pair<Vec3, Vec3> rigid_part(const TetMesh& mesh, const std::vector<Vec3>& u,
                                  const std::vector<Index>& of) {
-    const std::vector<Real> volume = node_volumes(mesh);
-    Real total = 0, spread = 0;
+    Real spread = 0;
     Vec3 centre = Vec3::Zero(), mean = Vec3::Zero(), turn = Vec3::Zero();
-    for (Index a : of) total += volume[a], centre += volume[a] * mesh.nodes[a];
-    centre /= total;
+    for (Index a : of) centre += mesh.nodes[a];
+    centre /= Real(of.size());
     for (Index a : of) {
         const Vec3 r = mesh.nodes[a] - centre;
-        mean += volume[a] * u[a], turn += volume[a] * r.cross(u[a]);
-        spread += volume[a] * r.squaredNorm();
+        mean += u[a], turn += r.cross(u[a]), spread += r.squaredNorm();
     }
-    return {mean / total, turn / spread};
+    return {mean / Real(of.size()), turn / spread};
 }
 
 Real largest(const std::vector<Vec3>& u) {
@@ -73,10 +58,10 @@ Real largest(const std::vector<Vec3>& u) {
     return m;
 }
 
-// A free bar pulled by sigma on its ends stretches by sigma / E; adding the body force of a rigid
-// acceleration (a net force and moment that strain nothing, each node's share by its volume)
-// changes nothing: the anchor takes it. With the spring alone the extra load moved the bar by
-// |f| / (1e-8 K), some 1e3 m.
+// A free bar pulled by sigma on its ends stretches by sigma / E; adding on every node the force
+// of a rigid acceleration of equal nodal masses (as a run's particles have; a problem without
+// gravity is balanced so) changes nothing: the anchor takes it. With the spring alone the extra
+// load moved the bar by |f| / (1e-8 K), some 1e3 m.
 TEST(LoadBalance, ANetLoadOnAnUnanchoredBarIsTakenByItsAnchor) {
     const Real L = 0.6, sigma = 1e3;
     const TetMesh mesh = box_mesh(box_lattice_nodes(Vec3::Zero(), Vec3(L, 0.2, 0.2), k_dx));
@@ -93,11 +78,9 @@ TEST(LoadBalance, ANetLoadOnAnUnanchoredBarIsTakenByItsAnchor) {
     EXPECT_EQ(pulled.unheld_pieces[0].size(), size_t(mesh.node_count()));
 
     BiotProblem pushed = pulled;
-    const std::vector<Real> volume = node_volumes(mesh);
     for (Index a = 0; a < mesh.node_count(); ++a)
         pushed.nodal_force[a] +=
-            volume[a] * 1e3 *
-            (Vec3(3, -2, 5) + 40 * Vec3(0.5, -1, 2).cross(mesh.nodes[a] - Vec3(0.3, 0.1, 0.1)));
+            Vec3(3, -2, 5) + 40 * Vec3(0.5, -1, 2).cross(mesh.nodes[a] - Vec3(0.3, 0.1, 0.1));
     const std::vector<Vec3> u = solve(mesh, pulled), u_pushed = solve(mesh, pushed);
 
     Real right = 0, left = 0;
@@ -179,6 +162,74 @@ TEST(LoadBalance, AnUnheldBlockDeformsAboutItsCentreOfMassAndItsWeightStrainsNot
     const auto [mean, turn] = rigid_part(mesh, u, p.unheld_pieces[0]);
     EXPECT_LT(mean.norm(), 1e-9 * largest(u)) << "m: the centre of mass moved";
     EXPECT_LT(turn.norm() * H, 1e-9 * largest(u)) << "the block turned";
+}
+
+// A block hanging from an anchored one by an edge (no face shared: an unheld piece). The rigid
+// motion removed from its solution (LoadBalance::remove_rigid_motion) is a turn about that edge:
+// it never moves the edge's nodes, which the anchored block's tets share. Removing the piece's
+// fitted translation there instead sheared the anchored block's top tets by u / dx.
+TEST(LoadBalance, TheRigidMotionRemovedFromAPieceHangingByAnEdgeTurnsItAboutTheEdge) {
+    const TetMesh block = box_mesh(box_lattice_nodes(Vec3::Zero(), Vec3(0.3, 0.3, 0.3), k_dx));
+    const TetMesh hanging =
+        box_mesh(box_lattice_nodes(Vec3(0.3, 0, 0.3), Vec3(0.6, 0.3, 0.6), k_dx));
+    TetMesh mesh = block;  // the two, the edge x = z = 0.3 once
+    std::vector<Index> map(hanging.node_count());
+    for (Index b = 0; b < hanging.node_count(); ++b) {
+        map[b] = mesh.node_count();
+        for (Index a = 0; a < block.node_count(); ++a)
+            if ((block.nodes[a] - hanging.nodes[b]).norm() < 1e-9) map[b] = a;
+        if (map[b] == mesh.node_count()) mesh.nodes.push_back(hanging.nodes[b]);
+    }
+    for (Tet t : hanging.tets) {
+        for (Index& a : t) a = map[a];
+        mesh.tets.push_back(t);
+    }
+    BiotProblem p = elastic_problem(mesh);
+    std::vector<char> prescribed(3 * mesh.node_count(), 0);
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        if (mesh.nodes[a][2] < 1e-9)
+            p.fixed[a] = FixAll, prescribed[3 * a] = 1, prescribed[3 * a + 1] = 1,
+            prescribed[3 * a + 2] = 1;
+    p.unheld_pieces = unheld_pieces(mesh, p.fixed);
+    ASSERT_EQ(p.unheld_pieces.size(), 1u);
+    const DofSplit dofs(prescribed);
+    const LoadBalance balance(mesh, p, dofs, Vector::Ones(mesh.node_count()));
+    const auto on_edge = [](const Vec3& x) {
+        return std::abs(x[0] - 0.3) < 1e-9 && std::abs(x[2] - 0.3) < 1e-9;
+    };
+    std::vector<char> in_piece(mesh.node_count(), 0);
+    for (Index a : p.unheld_pieces[0]) in_piece[a] = 1;
+
+    // Every free node moved by t: the edge keeps t, and so does the anchored block.
+    const Vec3 t(1e-3, -2e-3, 3e-3);
+    Vector u(dofs.free_count);
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        for (int d = 0; d < 3; ++d)
+            if (const int row = dofs.free_index[3 * a + d]; row >= 0) u[row] = t[d];
+    balance.remove_rigid_motion(u);
+    Real moved = 0, piece_change = 0;
+    for (Index a = 0; a < mesh.node_count(); ++a)
+        for (int d = 0; d < 3; ++d)
+            if (const int row = dofs.free_index[3 * a + d]; row >= 0) {
+                const Real change = std::abs(u[row] - t[d]);
+                if (!in_piece[a] || on_edge(mesh.nodes[a]))
+                    moved = std::max(moved, change);
+                else
+                    piece_change = std::max(piece_change, change);
+            }
+    EXPECT_LT(moved, 1e-15) << "m: the edge or the anchored block moved";
+    EXPECT_GT(piece_change, 0.1 * t.norm()) << "m: no turn about the edge was fitted";
+
+    // A turn of the piece about the edge is removed whole.
+    const Vec3 theta(0, 2e-3, 0), pivot(0.3, 0, 0.3);
+    u.setZero();
+    for (Index a : p.unheld_pieces[0]) {
+        const Vec3 turn = theta.cross(mesh.nodes[a] - pivot);
+        for (int d = 0; d < 3; ++d)
+            if (const int row = dofs.free_index[3 * a + d]; row >= 0) u[row] = turn[d];
+    }
+    balance.remove_rigid_motion(u);
+    EXPECT_LT(u.lpNorm<Eigen::Infinity>(), 1e-15) << "m left of a turn about the edge";
 }
 
 }  // namespace

@@ -37,11 +37,10 @@ BiotSolver::Impl::Impl(const TetMesh& m, BiotProblem p, BiotOptions o, const Bio
     f_body = f_ext;
     f_extra = Vector::Zero(3 * n), f_rest = Vector::Zero(3 * n);
     apply_boundary_values(problem.nodal_force, problem.prescribed_u, problem.drained_pressure);
-    KARST_CHECK(problem.node_mass.empty() || problem.node_mass.size() == size_t(n));
-    balance = LoadBalance(mesh.nodes, problem, u_dofs,
-                          problem.node_mass.empty()
-                              ? lumped_volume
-                              : Vector(Eigen::Map<const Vector>(problem.node_mass.data(), n)));
+    // [D] The relief follows the weight: a problem with gravity spreads it by the lumped
+    // volumes; a coupled run's weight comes as its particles' weights, equal on the lattice.
+    balance = LoadBalance(mesh, problem, u_dofs,
+                          problem.gravity.squaredNorm() > 0 ? lumped_volume : Vector::Ones(n));
     mass_ff = p_dofs.split(mass).first;
     assemble_flow();
     t_assembly = watch.seconds();

@@ -63,10 +63,6 @@ struct BiotProblem {
     /// holds it in place, as its anchored fragment is, instead of a net load moving it by
     /// |f| / (eps K). With free_body and no pieces, the whole mesh is one piece.
     std::vector<std::vector<Index>> unheld_pieces;
-    /// Optional, per node: the masses by which those pieces' loads are balanced and whose centre
-    /// their deformation keeps (a run's particles' solid mass, whose weight its energy account
-    /// reads); empty: the lumped volumes.
-    std::vector<Real> node_mass;
     Real rigid_mode_spring = 1e-8;
 };
 

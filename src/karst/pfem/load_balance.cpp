@@ -5,6 +5,7 @@
 
 #include <Eigen/QR>
 
+#include <algorithm>
 #include <numeric>
 #include <tuple>
 
@@ -22,31 +23,36 @@ struct PieceModes {
     std::vector<std::pair<int, Eigen::VectorXd>> values;
 };
 
-/// The free rigid motions R of a group's nodes on its rows (`local`: free row -> group row, of
-/// `w.size()`) and their fit (R^T W R)^-1 R^T W, W = diag(w).
-std::pair<Eigen::MatrixXd, Eigen::MatrixXd> rigid_fit(
-    const std::vector<Vec3>& nodes, const std::vector<std::uint8_t>& fixed, const DofSplit& dofs,
-    const std::vector<Index>& group, const std::vector<int>& local, const Eigen::VectorXd& w) {
+/// The rigid motions R of a group's nodes that leave their `held_axes` (FixedAxes bits) in
+/// place, on the group's rows (`local`: free row -> group row, of `m`), and their least-squares
+/// fit (R^T R)^-1 R^T: every node weighs alike, as the particles of a structure do.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> rigid_fit(const std::vector<Vec3>& nodes,
+                                                      const std::vector<std::uint8_t>& held_axes,
+                                                      const DofSplit& dofs,
+                                                      const std::vector<Index>& group,
+                                                      const std::vector<int>& local,
+                                                      Eigen::Index m) {
     std::vector<Vec3> x;
     std::vector<std::uint8_t> held;
-    for (Index a : group) x.push_back(nodes[a]), held.push_back(fixed[a]);
+    for (Index a : group) x.push_back(nodes[a]), held.push_back(held_axes[a]);
     const Eigen::Matrix<Real, 6, Eigen::Dynamic> free = free_rigid_modes(x, held);
     if (free.cols() == 0) return {};
     const RigidFrame frame(x);
-    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(w.size(), free.cols());
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, free.cols());
     for (size_t i = 0; i < group.size(); ++i)
         for (int d = 0; d < 3; ++d)
             if (const int row = dofs.free_index[3 * group[i] + d]; row >= 0 && local[row] >= 0)
                 R.row(local[row]) = frame.row(x[i], d) * free;
-    const Eigen::MatrixXd RtW = R.transpose() * w.asDiagonal();
-    Eigen::MatrixXd fit = (RtW * R).completeOrthogonalDecomposition().solve(RtW);
+    Eigen::MatrixXd fit =
+        (R.transpose() * R).completeOrthogonalDecomposition().solve(R.transpose());
     return {std::move(R), std::move(fit)};
 }
 
 }  // namespace
 
-LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& problem,
-                         const DofSplit& dofs, const Vector& node_mass) {
+LoadBalance::LoadBalance(const TetMesh& mesh, const BiotProblem& problem, const DofSplit& dofs,
+                         const Vector& relief_weight) {
+    const std::vector<Vec3>& nodes = mesh.nodes;
     const Index n = Index(nodes.size());
     std::vector<std::vector<Index>> whole;
     if (problem.free_body && problem.unheld_pieces.empty()) {
@@ -102,22 +108,27 @@ LoadBalance::LoadBalance(const std::vector<Vec3>& nodes, const BiotProblem& prob
                     {columns[g]++, 1, {{add_row(g, row), Eigen::VectorXd::Ones(1)}}});
             }
 
-    // Each group's nodes, once each (a hinge node is in several of its pieces).
+    // Each group's nodes, once each (a hinge node is in several of its pieces), and the nodes
+    // that a held piece shares with them (a tet with a node in no unheld piece is held): the
+    // fitted motion leaves those where the held piece puts them.
     std::vector<std::vector<Index>> group_nodes(pieces.size());
     for (Index a = 0; a < n; ++a)
         if (pieces_at[a] > 0) group_nodes[root(owner[a])].push_back(a);
+    std::vector<std::uint8_t> held = problem.fixed;
+    for (const Tet& t : mesh.tets)
+        if (std::any_of(t.begin(), t.end(), [&](Index a) { return pieces_at[a] == 0; }))
+            for (Index a : t) held[a] = FixAll;
 
     for (size_t g = 0; g < pieces.size(); ++g) {
         if (rows[g].empty()) continue;
         Group out;
         const Eigen::Index m = Eigen::Index(rows[g].size());
-        Eigen::VectorXd w = Eigen::VectorXd::Zero(m);  // the rows' node masses
+        Eigen::VectorXd w = Eigen::VectorXd::Zero(m);  // the rows' relief weights
         for (Index a : group_nodes[g])
             for (int d = 0; d < 3; ++d)
                 if (const int row = dofs.free_index[3 * a + d]; row >= 0 && local[row] >= 0)
-                    w[local[row]] = node_mass[a];
-        std::tie(out.rigid, out.fit) =
-            rigid_fit(nodes, problem.fixed, dofs, group_nodes[g], local, w);
+                    w[local[row]] = relief_weight[a];
+        std::tie(out.rigid, out.fit) = rigid_fit(nodes, held, dofs, group_nodes[g], local, m);
         out.rows = std::move(rows[g]);
         if (double(m) * double(columns[g]) > k_max_basis_entries) {
             out.all_rows = true;

@@ -51,25 +51,6 @@ std::vector<Vec3> node_weights(const Model& model, const State& state, const Str
     return weight;
 }
 
-/// Each node's particle's solid mass (kg), the mass whose centre an unheld piece's deformation
-/// keeps (pfem/load_balance.hpp). It changes only with the mesh, so a rebuilt solver (a resumed
-/// run) gets the same; a node whose particle is gone takes the mean of the others (empty when
-/// every particle is gone).
-std::vector<Real> node_solid_mass(const State& state, const Structure& s) {
-    const PorousParticles& p = state.porous.particles;
-    const std::vector<Index> index_of = index_by_id(p, state.structures.node_of.size());
-    std::vector<Real> mass(s.node_id.size(), -1);
-    Real sum = 0;
-    size_t present = 0;
-    for (size_t a = 0; a < s.node_id.size(); ++a)
-        if (const Index i = index_of[s.node_id[a]]; i >= 0)
-            mass[a] = p.solid_mass[i], sum += mass[a], ++present;
-    if (present == 0) return {};
-    for (Real& m : mass)
-        if (m < 0) m = sum / Real(present);
-    return mass;
-}
-
 }  // namespace
 
 BiotFields fields_with_weight(const StructureState& st, const Structure& s) {
@@ -95,7 +76,6 @@ BiotSolver& solver_of(const Model& model, State& state, size_t slot) {
     // it shows.
     const bool coupled = !model.poroelastic_only();
     if (coupled) problem.gravity = Vec3::Zero();
-    problem.node_mass = node_solid_mass(state, s);
     std::optional<BiotSplitOf> split_of;
     if (BiotCache::Entry* older =
             s.split_of_version >= 0 ? state.biot_cache.find(slot, s.split_of_version) : nullptr)
